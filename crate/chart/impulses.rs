@@ -1,0 +1,93 @@
+//! The impulse-sequence chart: each impulse as a stem from 0 to its amplitude at its time.
+
+use super::{render_error, ChartStyle};
+use crate::error::Result;
+use crate::shaper::Shaper;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Draws the impulse sequences of one or more labelled shapers (overlaid, one colour each).
+pub fn draw_impulses<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    shapers: &[(&str, &Shaper)],
+    style: &ChartStyle,
+) -> Result<()> {
+    area.fill(&WHITE).map_err(render_error)?;
+    let t_max = shapers
+        .iter()
+        .map(|(_, s)| s.duration())
+        .fold(0.0_f64, f64::max);
+    let t_max = if t_max > 0.0 { t_max } else { 1.0 };
+    let (a_min, a_max) = shapers
+        .iter()
+        .flat_map(|(_, s)| s.impulses().iter().map(|imp| imp.amplitude))
+        .fold((0.0_f64, 0.0_f64), |(lo, hi), a| (lo.min(a), hi.max(a)));
+    let pad = 0.12 * (a_max - a_min).max(1e-9);
+    let x_pad = 0.06 * t_max;
+    let mut chart = ChartBuilder::on(area)
+        .caption("Impulse sequence", ("sans-serif", style.font(16.0)))
+        .margin(style.px(10.0))
+        .x_label_area_size(style.px(40.0))
+        .y_label_area_size(style.px(52.0))
+        .build_cartesian_2d(-x_pad..t_max + x_pad, (a_min - pad).min(0.0)..a_max + pad)
+        .map_err(render_error)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("amplitude")
+        .label_style(("sans-serif", style.font(12.0)))
+        .axis_desc_style(("sans-serif", style.font(13.0)))
+        .light_line_style(RGBColor(238, 238, 238))
+        .draw()
+        .map_err(render_error)?;
+    chart
+        .draw_series(LineSeries::new(
+            [(-x_pad, 0.0), (t_max + x_pad, 0.0)],
+            BLACK.stroke_width(style.px(1.0)),
+        ))
+        .map_err(render_error)?;
+    let n = shapers.len().max(1) as f64;
+    for (k, (label, shaper)) in shapers.iter().enumerate() {
+        let color = style.color(k);
+        // Offset overlaid series slightly so coincident stems stay visible.
+        let dx = if n > 1.0 {
+            (k as f64 - (n - 1.0) / 2.0) * 0.012 * t_max
+        } else {
+            0.0
+        };
+        let stroke = color.stroke_width(style.px(2.5));
+        chart
+            .draw_series(shaper.impulses().iter().map(|imp| {
+                PathElement::new(
+                    vec![(imp.time + dx, 0.0), (imp.time + dx, imp.amplitude)],
+                    stroke,
+                )
+            }))
+            .map_err(render_error)?
+            .label(label.to_string())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(3))
+            });
+        let r = style.px(4.0);
+        chart
+            .draw_series(
+                shaper
+                    .impulses()
+                    .iter()
+                    .map(|imp| Circle::new((imp.time + dx, imp.amplitude), r, color.filled())),
+            )
+            .map_err(render_error)?;
+    }
+    if shapers.len() > 1 {
+        chart
+            .configure_series_labels()
+            .label_font(("sans-serif", style.font(12.0)))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(180, 180, 180))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(render_error)?;
+    }
+    area.present().map_err(render_error)?;
+    Ok(())
+}

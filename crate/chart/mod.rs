@@ -1,0 +1,57 @@
+//! Charts, each written once against plotters' [`DrawingBackend`]: the page draws them on a
+//! canvas (plotters-canvas), native tests into an SVG string they can assert on.
+
+pub mod impulses;
+pub mod sensitivity;
+
+use crate::error::Error;
+use plotters::prelude::*;
+
+pub use impulses::draw_impulses;
+pub use sensitivity::draw_sensitivity;
+
+/// Colours of up to four overlaid series (colour-blind-safe Okabe–Ito hues).
+pub const SERIES_COLORS: [RGBColor; 4] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+];
+
+/// Look of a chart: `scale` multiplies fonts, strokes and margins (pass the device pixel ratio
+/// so a chart drawn on a high-DPI canvas reads at the same size).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChartStyle {
+    /// Multiplier for font sizes, stroke widths and margins (≥ 0.25).
+    pub scale: f64,
+}
+
+impl Default for ChartStyle {
+    fn default() -> Self {
+        ChartStyle { scale: 1.0 }
+    }
+}
+
+impl ChartStyle {
+    /// A length in pixels, scaled.
+    pub(crate) fn px(&self, base: f64) -> u32 {
+        (base * self.scale.clamp(0.25, 8.0)).round().max(1.0) as u32
+    }
+
+    /// A font size in pixels, scaled.
+    pub(crate) fn font(&self, base: f64) -> f64 {
+        base * self.scale.clamp(0.25, 8.0)
+    }
+
+    /// Colour of series `i`.
+    pub(crate) fn color(&self, i: usize) -> RGBColor {
+        SERIES_COLORS[i % SERIES_COLORS.len()]
+    }
+}
+
+/// Converts a plotters error into the crate's.
+pub(crate) fn render_error<E: std::fmt::Debug>(e: E) -> Error {
+    Error::Render {
+        reason: format!("{e:?}"),
+    }
+}

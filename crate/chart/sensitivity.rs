@@ -1,0 +1,103 @@
+//! The sensitivity chart: residual vibration V (in %) against frequency, with the tolerable
+//! level Vtol and the modes marked (Singhose 2009 Fig. 7).
+
+use super::{render_error, ChartStyle};
+use crate::error::Result;
+use crate::vibration::SensitivityCurve;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Draws sensitivity curves (one per labelled shaper), a horizontal line at `vtol` (fraction)
+/// and a vertical marker at each frequency in `modes_hz`.
+pub fn draw_sensitivity<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    curves: &[(&str, &SensitivityCurve)],
+    vtol: Option<f64>,
+    modes_hz: &[f64],
+    style: &ChartStyle,
+) -> Result<()> {
+    area.fill(&WHITE).map_err(render_error)?;
+    let (f_lo, f_hi) = curves
+        .iter()
+        .flat_map(|(_, c)| c.frequency_hz.iter().copied())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
+            (lo.min(f), hi.max(f))
+        });
+    let (f_lo, f_hi) = if f_lo < f_hi {
+        (f_lo, f_hi)
+    } else {
+        (0.0, 1.0)
+    };
+    let v_max = curves
+        .iter()
+        .flat_map(|(_, c)| c.vibration.iter().copied())
+        .filter(|v| v.is_finite())
+        .fold(vtol.unwrap_or(0.0), f64::max)
+        .max(1e-3)
+        * 100.0
+        * 1.06;
+    let mut chart = ChartBuilder::on(area)
+        .caption("Residual vibration V(f)", ("sans-serif", style.font(16.0)))
+        .margin(style.px(10.0))
+        .x_label_area_size(style.px(40.0))
+        .y_label_area_size(style.px(52.0))
+        .build_cartesian_2d(f_lo..f_hi, 0.0..v_max)
+        .map_err(render_error)?;
+    chart
+        .configure_mesh()
+        .x_desc("frequency (Hz)")
+        .y_desc("vibration (%)")
+        .label_style(("sans-serif", style.font(12.0)))
+        .axis_desc_style(("sans-serif", style.font(13.0)))
+        .light_line_style(RGBColor(238, 238, 238))
+        .draw()
+        .map_err(render_error)?;
+    let marker = RGBColor(120, 120, 120);
+    for &f in modes_hz.iter().filter(|f| (f_lo..=f_hi).contains(*f)) {
+        chart
+            .draw_series(LineSeries::new(
+                [(f, 0.0), (f, v_max)],
+                marker.stroke_width(style.px(1.0)),
+            ))
+            .map_err(render_error)?;
+    }
+    if let Some(vtol) = vtol {
+        let red = RGBColor(200, 30, 30);
+        chart
+            .draw_series(LineSeries::new(
+                [(f_lo, vtol * 100.0), (f_hi, vtol * 100.0)],
+                red.stroke_width(style.px(1.0)),
+            ))
+            .map_err(render_error)?
+            .label(format!("Vtol {:.3} %", vtol * 100.0))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], red.stroke_width(2)));
+    }
+    for (k, (label, curve)) in curves.iter().enumerate() {
+        let color = style.color(k);
+        chart
+            .draw_series(LineSeries::new(
+                curve
+                    .frequency_hz
+                    .iter()
+                    .zip(&curve.vibration)
+                    .filter(|(_, v)| v.is_finite())
+                    .map(|(&f, &v)| (f, v * 100.0)),
+                color.stroke_width(style.px(2.0)),
+            ))
+            .map_err(render_error)?
+            .label(label.to_string())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(3))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .label_font(("sans-serif", style.font(12.0)))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(180, 180, 180))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(render_error)?;
+    area.present().map_err(render_error)?;
+    Ok(())
+}

@@ -1,0 +1,38 @@
+//! # input-shaping
+//!
+//! Design and analysis of input shapers. A flexible machine driven by a reference command rings
+//! at its modes; convolving the command with a short sequence of impulses whose vibrations
+//! cancel at those modes (an *input shaper*) removes the residual vibration, and robust shapers
+//! keep doing so when the model is wrong (Singer & Seering 1988; Singhose 2009).
+//!
+//! ```
+//! use input_shaping::{design::zero_vibration::zvd, vibration::residual_vibration, Mode};
+//! let mode = Mode::new(2.0, 0.05)?;              // 2 Hz, ζ = 0.05
+//! let shaper = zvd(&mode)?;                        // three impulses over one damped period
+//! assert!(residual_vibration(&shaper, &mode) < 1e-12);
+//! # Ok::<(), input_shaping::Error>(())
+//! ```
+//!
+//! ## Module map
+//! - [`mode`]: a validated vibration mode (frequency in Hz, damping ratio).
+//! - [`shaper`]: the impulse sequence, convolution, duration, centroid delay.
+//! - [`vibration`]: V(ω, ζ) (Singhose 2009 eq. 11), sensitivity curves, insensitivity bands.
+//! - [`design`]: the spec, the table of families, and one file per family of the literature.
+//! - [`chart`]: charts drawn with plotters on any backend (canvas in the page, SVG in tests).
+//! - [`error`]: the one error type; nothing reachable from the public API panics.
+//! - `wasm` (wasm32 only): the JavaScript API (`design`, `residualVibration`, `sensitivity`, …).
+
+pub mod chart;
+pub mod design;
+pub mod error;
+pub mod mode;
+pub mod shaper;
+pub mod vibration;
+
+#[cfg(target_arch = "wasm32")]
+pub mod wasm;
+
+pub use design::{design, DesignRequest, ShaperSpec};
+pub use error::{Error, Result};
+pub use mode::{Mode, ModeSpec};
+pub use shaper::{Impulse, Shaper};

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# npm test: every test layer, stopping at the first failure, then one line totalling them all:
+# "N passed, N failed". Logs of each layer go to target/test-logs/.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+
+bash scripts/setup.sh --browser || { echo "setup failed"; echo "0 passed, 1 failed"; exit 1; }
+[ -f "$HOME/.cargo/env" ] && . "$HOME/.cargo/env"
+export PATH="$HOME/.cargo/bin:$PATH"
+export CHROMEDRIVER=/usr/bin/chromedriver
+
+logs=target/test-logs
+mkdir -p "$logs"
+passed=0
+failed=0
+
+# Adds up the counts a layer printed: cargo / wasm-bindgen-test ("test result: ok. N passed;
+# M failed") and node's test runner ("# pass N" / "# fail N" or "ℹ pass N" / "ℹ fail N").
+count() {
+  local log=$1 p f
+  read -r p f < <(awk '
+    /test result: [A-Za-z]+\. [0-9]+ passed; [0-9]+ failed/ {
+      for (i = 1; i <= NF; i++) { if ($i ~ /^passed;?$/) p += $(i-1); if ($i ~ /^failed;?$/) f += $(i-1) }
+    }
+    /^(# |ℹ )pass [0-9]+$/ { p += $NF }
+    /^(# |ℹ )fail [0-9]+$/ { f += $NF }
+    END { print p + 0, f + 0 }' "$log")
+  passed=$((passed + p))
+  failed=$((failed + f))
+}
+
+layer() {
+  local name=$1; shift
+  local log="$logs/$name.log"
+  printf '\n=== %s: %s\n' "$name" "$*"
+  local before=$failed
+  if "$@" 2>&1 | tee "$log"; then
+    count "$log"
+  else
+    count "$log"
+    [ "$failed" -eq "$before" ] && failed=$((failed + 1))
+    printf '\n=== %s FAILED (log: %s)\n' "$name" "$log"
+    echo "$passed passed, $failed failed"
+    exit 1
+  fi
+}
+
+layer fmt cargo fmt --check
+layer clippy cargo clippy --all-targets -- -D warnings
+layer clippy-wasm cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
+layer native cargo test
+layer wasm-node wasm-pack test --node
+layer wasm-browser wasm-pack test --headless --chrome
+layer build bash scripts/build.sh
+layer e2e node --test --test-reporter=tap tests/e2e/
+
+echo
+echo "$passed passed, $failed failed"

@@ -1,0 +1,32 @@
+//! Helpers shared by the integration tests: an evaluation of residual vibration that does not
+//! use the library's formula, by superposing the oscillator's impulse responses in time.
+#![allow(dead_code)]
+
+use input_shaping::{Mode, Shaper};
+
+/// Residual vibration amplitude after the last impulse, relative to a single unit impulse,
+/// computed from the time response: y(t) = Σ Aᵢ e^{−ζω(t−tᵢ)} sin(ω_d(t−tᵢ)) (the response of
+/// y'' + 2ζωy' + ω²y = impulse, up to a constant). At t = t_n the free oscillation has
+/// amplitude √(y² + ((y' + ζωy)/ω_d)²); the single unit impulse's is 1 at t = 0.
+pub fn residual_by_superposition(shaper: &Shaper, mode: &Mode) -> f64 {
+    let w = mode.omega_rad_s();
+    let z = mode.damping();
+    let wd = mode.damped_omega_rad_s();
+    let t = shaper.duration();
+    let (mut y, mut dy) = (0.0, 0.0);
+    for imp in shaper.impulses() {
+        let tau = t - imp.time;
+        let e = (-z * w * tau).exp();
+        y += imp.amplitude * e * (wd * tau).sin();
+        dy += imp.amplitude * e * (wd * (wd * tau).cos() - z * w * (wd * tau).sin());
+    }
+    (y * y + ((dy + z * w * y) / wd).powi(2)).sqrt()
+}
+
+/// Asserts `a ≈ b` within `tol`, with a message.
+pub fn close(a: f64, b: f64, tol: f64, what: &str) {
+    assert!(
+        (a - b).abs() <= tol,
+        "{what}: got {a}, expected {b} (tolerance {tol})"
+    );
+}

@@ -1,0 +1,60 @@
+// Shared set-up for the end-to-end tests: a static server on 127.0.0.1 started by the test
+// itself, and Debian's Chromium driven by playwright-core.
+import { chromium } from 'playwright-core';
+import { mkdirSync } from 'node:fs';
+import { fileURLToPath } from 'node:url';
+import { startServer } from '../../scripts/serve.mjs';
+
+export const SCREENSHOTS = fileURLToPath(new URL('./screenshots/', import.meta.url));
+
+const ARGS = [
+  '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+  '--disable-background-networking', '--disable-component-update', '--disable-sync',
+];
+
+/** Starts the server and the browser; returns helpers and a `close()`. */
+export async function openBrowser() {
+  mkdirSync(SCREENSHOTS, { recursive: true });
+  const { server, url } = await startServer({ port: 0 });
+  const browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+    args: ARGS,
+  });
+  return {
+    url,
+    /** A fresh page at the playground, with console errors and page errors collected. */
+    async page({ width = 1280, height = 800 } = {}) {
+      const page = await browser.newPage({ viewport: { width, height } });
+      const problems = [];
+      page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
+      page.on('pageerror', (e) => problems.push(`pageerror: ${e.message}`));
+      await page.goto(url);
+      await page.waitForSelector('body[data-ready="true"]', { timeout: 20000 });
+      return { page, problems };
+    },
+    async close() {
+      await browser.close();
+      await new Promise((ok) => server.close(ok));
+    },
+  };
+}
+
+/** Number of canvas pixels that are not (near) white, and a hash of all pixels. */
+export async function canvasInfo(page, id) {
+  return page.evaluate((canvasId) => {
+    const c = document.getElementById(canvasId);
+    const data = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let ink = 0;
+    let hash = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      if (data[i] < 230 || data[i + 1] < 230 || data[i + 2] < 230) ink++;
+      hash = (hash * 31 + data[i] + 7 * data[i + 1] + 13 * data[i + 2]) >>> 0;
+    }
+    return { ink, hash, width: c.width, height: c.height };
+  }, id);
+}
+
+/** Sets an input's value as a user typing would (fires `input`). */
+export async function type(page, id, value) {
+  await page.fill(`#${id}`, String(value));
+}

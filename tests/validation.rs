@@ -1,0 +1,161 @@
+//! Bad input gives typed errors that name the field; nothing panics.
+
+use input_shaping::vibration::insensitivity;
+use input_shaping::{design, DesignRequest, Error, Impulse, Mode, ModeSpec, Shaper, ShaperSpec};
+use wasm_bindgen_test::wasm_bindgen_test;
+
+#[wasm_bindgen_test(unsupported = test)]
+fn mode_rejects_out_of_domain_values() {
+    let bad = [
+        (f64::NAN, 0.1, "frequencyHz"),
+        (f64::INFINITY, 0.1, "frequencyHz"),
+        (-2.0, 0.1, "frequencyHz"),
+        (0.0, 0.1, "frequencyHz"),
+        (1e-320, 0.1, "frequencyHz"),
+        (1e12, 0.1, "frequencyHz"),
+        (2.0, 1.0, "damping"),
+        (2.0, 1.5, "damping"),
+        (2.0, -0.01, "damping"),
+        (2.0, f64::NAN, "damping"),
+    ];
+    for (f, z, field) in bad {
+        let err = Mode::new(f, z).unwrap_err();
+        assert_eq!(err.field(), Some(field), "{f} {z}: {err}");
+    }
+    assert!(Mode::new(2.0, 0.999).is_ok());
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn mode_list_names_the_index() {
+    let err = Mode::list(&[
+        ModeSpec {
+            frequency_hz: 1.0,
+            damping: 0.0,
+        },
+        ModeSpec {
+            frequency_hz: 2.0,
+            damping: 2.0,
+        },
+    ])
+    .unwrap_err();
+    assert_eq!(err.field(), Some("modes[1].damping"));
+    assert_eq!(Mode::list(&[]).unwrap_err().field(), Some("modes"));
+    let dup = ModeSpec {
+        frequency_hz: 1.0,
+        damping: 0.1,
+    };
+    assert_eq!(
+        Mode::list(&[dup, dup]).unwrap_err().field(),
+        Some("modes[1]")
+    );
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn shaper_is_sorted_merged_and_starts_at_zero() {
+    let s = Shaper::new(vec![
+        Impulse {
+            time: 3.0,
+            amplitude: 0.25,
+        },
+        Impulse {
+            time: 1.0,
+            amplitude: 0.5,
+        },
+        Impulse {
+            time: 3.0,
+            amplitude: 0.25,
+        },
+    ])
+    .unwrap();
+    assert_eq!(
+        s.impulses(),
+        &[
+            Impulse {
+                time: 0.0,
+                amplitude: 0.5
+            },
+            Impulse {
+                time: 2.0,
+                amplitude: 0.5
+            }
+        ]
+    );
+    assert_eq!(s.duration(), 2.0);
+    assert_eq!(s.centroid_delay(), Some(1.0));
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn shaper_rejects_bad_impulses() {
+    let imp = |time, amplitude| Impulse { time, amplitude };
+    assert_eq!(Shaper::new(vec![]).unwrap_err().field(), Some("impulses"));
+    assert_eq!(
+        Shaper::new(vec![imp(0.0, 1.0), imp(f64::NAN, 1.0)])
+            .unwrap_err()
+            .field(),
+        Some("impulses[1].time")
+    );
+    assert_eq!(
+        Shaper::new(vec![imp(0.0, f64::INFINITY)])
+            .unwrap_err()
+            .field(),
+        Some("impulses[0].amplitude")
+    );
+    assert_eq!(
+        Shaper::new(vec![imp(-1.0, 1.0)]).unwrap_err().field(),
+        Some("impulses[0].time")
+    );
+    assert_eq!(
+        Shaper::new(vec![imp(0.0, 0.0)]).unwrap_err().field(),
+        Some("impulses")
+    );
+    assert!(matches!(
+        Shaper::new(vec![imp(0.0, 1.0); 5000]),
+        Err(Error::TooLarge { .. })
+    ));
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn design_errors_name_the_mode() {
+    let request = DesignRequest {
+        modes: vec![ModeSpec {
+            frequency_hz: -3.0,
+            damping: 0.1,
+        }],
+        shaper: ShaperSpec::Zv,
+    };
+    let err = design(&request).unwrap_err();
+    assert_eq!(err.field(), Some("modes[0].frequencyHz"));
+    assert!(err.to_string().contains("greater than 0"), "{err}");
+}
+
+/// Convolving per-mode shapers is bounded: many modes of a long family give TooLarge, not OOM.
+#[wasm_bindgen_test(unsupported = test)]
+fn convolution_size_is_bounded() {
+    let modes: Vec<ModeSpec> = (1..=12)
+        .map(|i| ModeSpec {
+            frequency_hz: i as f64 * 1.37,
+            damping: 0.01,
+        })
+        .collect();
+    let err = design(&DesignRequest {
+        modes,
+        shaper: ShaperSpec::Zvdn { derivatives: 3 },
+    })
+    .unwrap_err();
+    assert!(matches!(err, Error::TooLarge { .. }), "{err}");
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn insensitivity_rejects_bad_vtol_and_reports_empty_bands() {
+    let mode = Mode::new(1.0, 0.0).unwrap();
+    for vtol in [0.0, -0.1, 1.0, f64::NAN] {
+        assert_eq!(
+            insensitivity(&Shaper::identity(), &mode, vtol)
+                .unwrap_err()
+                .field(),
+            Some("vtol")
+        );
+    }
+    let band = insensitivity(&Shaper::identity(), &mode, 0.05).unwrap();
+    assert_eq!((band.width, band.low_hz, band.high_hz), (0.0, 1.0, 1.0));
+}

@@ -1,0 +1,139 @@
+//! Residual vibration V(ω, ζ), sensitivity curves and their validation.
+
+mod common;
+
+use common::{close, residual_by_superposition};
+use input_shaping::vibration::{residual_vibration, sensitivity, SensitivityOptions};
+use input_shaping::{Error, Impulse, Mode, Shaper};
+use std::f64::consts::PI;
+use wasm_bindgen_test::wasm_bindgen_test;
+
+fn shaper(pairs: &[(f64, f64)]) -> Shaper {
+    Shaper::new(
+        pairs
+            .iter()
+            .map(|&(time, amplitude)| Impulse { time, amplitude })
+            .collect(),
+    )
+    .unwrap()
+}
+
+/// A single unit impulse leaves all the vibration: V = 1 (Singhose 2009 eq. 10–11 normalisation).
+#[wasm_bindgen_test(unsupported = test)]
+fn unshaped_is_one() {
+    for z in [0.0, 0.2, 0.9] {
+        let mode = Mode::new(4.0, z).unwrap();
+        close(
+            residual_vibration(&Shaper::identity(), &mode),
+            1.0,
+            1e-15,
+            "V of identity",
+        );
+    }
+}
+
+/// Eq. 11 agrees with an independent time-domain superposition for arbitrary (also negative)
+/// shapers, frequencies and dampings.
+#[wasm_bindgen_test(unsupported = test)]
+fn formula_agrees_with_superposition() {
+    let s = shaper(&[(0.0, 0.7), (0.13, -0.4), (0.31, 0.5), (0.5, 0.2)]);
+    for z in [0.0, 0.03, 0.25, 0.6] {
+        for f in [0.3, 1.0, 2.7, 11.0] {
+            let mode = Mode::new(f, z).unwrap();
+            close(
+                residual_vibration(&s, &mode),
+                residual_by_superposition(&s, &mode),
+                1e-12,
+                "eq. 11 vs superposition",
+            );
+        }
+    }
+}
+
+/// The ZV sensitivity curve at ζ = 0 is |cos(πf/(2f_m))| (two equal impulses half a period apart).
+#[wasm_bindgen_test(unsupported = test)]
+fn zv_sensitivity_curve_is_a_cosine() {
+    let s = shaper(&[(0.0, 0.5), (0.25, 0.5)]); // ZV for 2 Hz, ζ = 0
+    let curve = sensitivity(
+        &s,
+        &SensitivityOptions {
+            from_hz: 0.0,
+            to_hz: 6.0,
+            points: 121,
+            damping: 0.0,
+        },
+    )
+    .unwrap();
+    assert_eq!(curve.frequency_hz.len(), 121);
+    assert_eq!(curve.frequency_hz[0], 0.0);
+    assert_eq!(curve.frequency_hz[120], 6.0);
+    for (f, v) in curve.frequency_hz.iter().zip(&curve.vibration) {
+        close(*v, (PI * f / 4.0).cos().abs(), 1e-12, "V(f)");
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn sensitivity_rejects_bad_options() {
+    let s = Shaper::identity();
+    let ok = SensitivityOptions {
+        from_hz: 0.0,
+        to_hz: 10.0,
+        points: 100,
+        damping: 0.1,
+    };
+    let cases = [
+        (
+            SensitivityOptions {
+                from_hz: f64::NAN,
+                ..ok
+            },
+            "fromHz",
+        ),
+        (
+            SensitivityOptions {
+                from_hz: -1.0,
+                ..ok
+            },
+            "fromHz",
+        ),
+        (SensitivityOptions { to_hz: 0.0, ..ok }, "toHz"),
+        (
+            SensitivityOptions {
+                to_hz: f64::INFINITY,
+                ..ok
+            },
+            "toHz",
+        ),
+        (SensitivityOptions { points: 1, ..ok }, "points"),
+        (
+            SensitivityOptions {
+                points: 1_000_000_000,
+                ..ok
+            },
+            "points",
+        ),
+        (SensitivityOptions { damping: 1.0, ..ok }, "damping"),
+        (
+            SensitivityOptions {
+                damping: -0.1,
+                ..ok
+            },
+            "damping",
+        ),
+    ];
+    for (options, field) in cases {
+        let err = sensitivity(&s, &options).unwrap_err();
+        assert_eq!(err.field(), Some(field), "{err}");
+        assert!(err.to_string().starts_with(field), "{err}");
+    }
+    assert!(matches!(
+        sensitivity(
+            &s,
+            &SensitivityOptions {
+                points: 1_000_000_000,
+                ..ok
+            }
+        ),
+        Err(Error::TooLarge { .. })
+    ));
+}

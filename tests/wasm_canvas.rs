@@ -1,0 +1,106 @@
+//! Charts drawn on real canvases in headless Chromium (`wasm-pack test --headless --chrome`):
+//! after `renderPlayground` the canvases hold the chart's pixels, and a bad input leaves them
+//! as they were.
+#![cfg(target_arch = "wasm32")]
+
+use input_shaping::wasm;
+use js_sys::{Reflect, JSON};
+use wasm_bindgen::{JsCast, JsValue};
+use wasm_bindgen_test::{wasm_bindgen_test, wasm_bindgen_test_configure};
+use web_sys::{CanvasRenderingContext2d, HtmlCanvasElement};
+
+wasm_bindgen_test_configure!(run_in_browser);
+
+fn canvas(width: u32, height: u32) -> HtmlCanvasElement {
+    let document = web_sys::window().unwrap().document().unwrap();
+    let c: HtmlCanvasElement = document
+        .create_element("canvas")
+        .unwrap()
+        .dyn_into()
+        .unwrap();
+    c.set_width(width);
+    c.set_height(height);
+    document.body().unwrap().append_child(&c).unwrap();
+    c
+}
+
+fn pixels(c: &HtmlCanvasElement) -> Vec<u8> {
+    let ctx: CanvasRenderingContext2d = c.get_context("2d").unwrap().unwrap().dyn_into().unwrap();
+    ctx.get_image_data(0.0, 0.0, c.width() as f64, c.height() as f64)
+        .unwrap()
+        .data()
+        .to_vec()
+}
+
+/// Counts pixels of roughly the first series colour (0, 114, 178).
+fn series_pixels(data: &[u8]) -> usize {
+    data.chunks(4)
+        .filter(|p| {
+            (p[0] as i32) < 60 && (p[1] as i32 - 114).abs() < 40 && (p[2] as i32 - 178).abs() < 40
+        })
+        .count()
+}
+
+#[wasm_bindgen_test]
+fn render_playground_draws_both_charts_and_keeps_them_on_error() {
+    let (imp, sens) = (canvas(640, 360), canvas(640, 360));
+    let canvases = js_sys::Object::new();
+    Reflect::set(&canvases, &"impulses".into(), &imp).unwrap();
+    Reflect::set(&canvases, &"sensitivity".into(), &sens).unwrap();
+    let state = JSON::parse(r#"{"modes":[{"frequencyHz":2,"damping":0.05}],"shaper":{"family":"zvd"},"view":{"vtol":0.05}}"#).unwrap();
+    let result = wasm::render_playground(state, canvases.clone().into()).unwrap();
+    let before_imp = pixels(&imp);
+    let before_sens = pixels(&sens);
+    // White background, stems and curve in the series colour.
+    assert!(
+        series_pixels(&before_imp) > 200,
+        "impulse stems drawn: {}",
+        series_pixels(&before_imp)
+    );
+    assert!(
+        series_pixels(&before_sens) > 300,
+        "sensitivity curve drawn: {}",
+        series_pixels(&before_sens)
+    );
+    let white = before_imp
+        .chunks(4)
+        .filter(|p| p[0] > 250 && p[1] > 250 && p[2] > 250)
+        .count();
+    assert!(white > 640 * 360 / 2, "mostly white background");
+    let ins: js_sys::Array = Reflect::get(&result, &"insensitivity".into())
+        .unwrap()
+        .dyn_into()
+        .unwrap();
+    let width = Reflect::get(&ins.get(0), &"width".into())
+        .unwrap()
+        .as_f64()
+        .unwrap();
+    assert!(
+        width > 0.2 && width < 0.4,
+        "ZVD I(5 %) near 0.29 at ζ = 0.05: {width}"
+    );
+
+    let bad =
+        JSON::parse(r#"{"modes":[{"frequencyHz":2,"damping":1.2}],"shaper":{"family":"zvd"}}"#)
+            .unwrap();
+    let err: js_sys::Error = wasm::render_playground(bad, canvases.into())
+        .unwrap_err()
+        .dyn_into()
+        .unwrap();
+    assert_eq!(
+        Reflect::get(&err, &"field".into())
+            .unwrap()
+            .as_string()
+            .as_deref(),
+        Some("modes[0].damping")
+    );
+    assert_eq!(pixels(&imp), before_imp, "impulse chart kept");
+    assert_eq!(pixels(&sens), before_sens, "sensitivity chart kept");
+}
+
+#[wasm_bindgen_test]
+fn missing_canvases_are_skipped() {
+    let state = JSON::parse(r#"{"modes":[{"frequencyHz":5}],"shaper":{"family":"zv"}}"#).unwrap();
+    let result = wasm::render_playground(state, JsValue::from(js_sys::Object::new())).unwrap();
+    assert!(Reflect::get(&result, &"shaper".into()).unwrap().is_object());
+}
