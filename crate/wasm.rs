@@ -217,10 +217,7 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
             1.0
         },
     };
-    let label = design::FAMILIES
-        .iter()
-        .find(|f| Some(f.name) == family_name(&state.shaper))
-        .map_or("shaper", |f| f.title);
+    let label = state.shaper.info().map_or("shaper", |f| f.title);
     if let Some(c) = canvas(&canvases, "impulses") {
         if let Some(backend) = CanvasBackend::with_canvas_object(c) {
             chart::draw_impulses(&backend.into_drawing_area(), &[(label, &shaper)], &style)
@@ -246,15 +243,5 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
         insensitivity,
         residual_at_modes,
         centroid_delay: shaper.centroid_delay(),
-    })
-}
-
-/// The `family` string of a spec.
-fn family_name(spec: &ShaperSpec) -> Option<&'static str> {
-    Some(match spec {
-        ShaperSpec::Zv => "zv",
-        ShaperSpec::Zvd => "zvd",
-        ShaperSpec::Zvdd => "zvdd",
-        ShaperSpec::Zvdn { .. } => "zvdn",
     })
 }

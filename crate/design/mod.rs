@@ -34,6 +34,23 @@ pub enum ShaperSpec {
     },
 }
 
+impl ShaperSpec {
+    /// The `family` string of this spec (the key of its row in [`FAMILIES`]).
+    pub fn name(&self) -> &'static str {
+        match self {
+            ShaperSpec::Zv => "zv",
+            ShaperSpec::Zvd => "zvd",
+            ShaperSpec::Zvdd => "zvdd",
+            ShaperSpec::Zvdn { .. } => "zvdn",
+        }
+    }
+
+    /// The row of [`FAMILIES`] describing this spec's family.
+    pub fn info(&self) -> Option<&'static FamilyInfo> {
+        FAMILIES.iter().find(|f| f.name == self.name())
+    }
+}
+
 /// A complete design request: the modes and the family with its parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DesignRequest {
@@ -92,10 +109,23 @@ pub const FAMILIES: &[FamilyInfo] = &[
     },
 ];
 
-/// What a designed shaper promises, checked before it is returned.
-enum Guarantee {
+/// What a designed shaper promises, checked by [`verify`] before it is returned.
+#[derive(Debug, Clone, PartialEq)]
+#[allow(dead_code)] // AtMost and Valid are for the solved and custom families being added
+pub(crate) enum Guarantee {
     /// V = 0 at every mode (to rounding).
     ZeroAtModes,
+    /// V ≤ `vtol` (to `tolerance`) at every listed (frequency in Hz, damping ratio) point.
+    AtMost {
+        /// Tolerable vibration, fraction.
+        vtol: f64,
+        /// Points where the bound must hold.
+        points: Vec<(f64, f64)>,
+        /// Allowed excess over `vtol` from rounding and solver tolerance.
+        tolerance: f64,
+    },
+    /// Nothing beyond a valid impulse sequence (e.g. a user's custom shaper).
+    Valid,
 }
 
 /// Largest V accepted as "zero" when checking a zero-vibration guarantee.
@@ -152,8 +182,32 @@ fn per_mode(modes: &[Mode], single: impl Fn(&Mode) -> Result<Shaper>) -> Result<
 
 /// Evaluates the shaper independently of how it was designed and refuses to return one that
 /// breaks its promise.
-fn verify(shaper: &Shaper, modes: &[Mode], guarantee: &Guarantee) -> Result<()> {
+pub(crate) fn verify(shaper: &Shaper, modes: &[Mode], guarantee: &Guarantee) -> Result<()> {
     match guarantee {
+        Guarantee::Valid => {}
+        Guarantee::AtMost {
+            vtol,
+            points,
+            tolerance,
+        } => {
+            for &(f, z) in points {
+                let v = crate::vibration::vibration_rad(
+                    shaper.impulses(),
+                    2.0 * std::f64::consts::PI * f,
+                    z,
+                );
+                if v.is_nan() || v > vtol + tolerance {
+                    return Err(Error::Infeasible {
+                        reason: format!(
+                            "the designed shaper leaves V = {:.4} % at {f} Hz, ζ = {z}, above \
+                             Vtol = {:.4} %",
+                            v * 100.0,
+                            vtol * 100.0
+                        ),
+                    });
+                }
+            }
+        }
         Guarantee::ZeroAtModes => {
             for (i, mode) in modes.iter().enumerate() {
                 let v = residual_vibration(shaper, mode);
