@@ -18,6 +18,8 @@
 //! - [`shaper`]: the impulse sequence, convolution, duration, centroid delay.
 //! - [`vibration`]: V(ω, ζ) (Singhose 2009 eq. 11), sensitivity curves, insensitivity bands.
 //! - [`design`]: the spec, the table of families, and one file per family of the literature.
+//! - [`smoothing`]: Klipper-compatible smoothing and suggested maximum acceleration.
+//! - [`export`]: CSV, JSON, C arrays and RepRapFirmware `M593` lines.
 //! - [`chart`]: charts drawn with plotters on any backend (canvas in the page, SVG in tests).
 //! - [`error`]: the one error type; nothing reachable from the public API panics.
 //! - `wasm` (wasm32 only): the JavaScript API (`design`, `residualVibration`, `sensitivity`, …).
@@ -25,8 +27,10 @@
 pub mod chart;
 pub mod design;
 pub mod error;
+pub mod export;
 pub mod mode;
 pub mod shaper;
+pub mod smoothing;
 pub mod vibration;
 
 #[cfg(target_arch = "wasm32")]

@@ -245,3 +245,67 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
         centroid_delay: shaper.centroid_delay(),
     })
 }
+
+/// Options of [`export_shaper`].
+#[derive(Deserialize)]
+#[serde(rename_all = "camelCase")]
+struct ExportOptions {
+    /// `"csv"`, `"json"`, `"c"` or `"rrf"`.
+    format: String,
+    /// C identifier prefix for `"c"` (default `shaper`).
+    #[serde(default)]
+    name: Option<String>,
+    /// First-line comment for `"c"`.
+    #[serde(default)]
+    comment: Option<String>,
+}
+
+/// `exportShaper(shaper, { format, name?, comment? })` → the export as a string: `"csv"`
+/// (`time_s,amplitude` rows), `"json"` (as `design` returns), `"c"` (float arrays
+/// `<name>_time_s`, `<name>_amplitude`), `"rrf"` (RepRapFirmware 3.6+ `M593 P"custom"` line).
+#[wasm_bindgen(js_name = exportShaper)]
+pub fn export_shaper(shaper: JsValue, options: JsValue) -> Result<String, JsValue> {
+    use crate::export;
+    let shaper = shaper_from_js(shaper).map_err(js_error)?;
+    let options: ExportOptions = from_js(options, "options").map_err(js_error)?;
+    match options.format.as_str() {
+        "csv" => Ok(export::to_csv(&shaper)),
+        "json" => Ok(export::to_json(&shaper)),
+        "c" => export::to_c_float(
+            &shaper,
+            options.name.as_deref().unwrap_or("shaper"),
+            options.comment.as_deref().unwrap_or("input shaper"),
+        )
+        .map_err(|e| js_error(e.within("options"))),
+        "rrf" => export::to_rrf_m593(&shaper).map_err(|e| js_error(e.within("shaper"))),
+        other => Err(js_error(Error::invalid(
+            "options.format",
+            format!("unknown export format {other:?}; expected csv, json, c or rrf"),
+        ))),
+    }
+}
+
+/// `klipperFigures(shaper, { scv })` → `{ smoothing, maxAccel }` with Klipper's definitions
+/// (smoothing in mm at 5000 mm/s², suggested max acceleration in mm/s² at 0.12 mm smoothing;
+/// `scv` is the square corner velocity in mm/s, default 5). `maxAccel` is `null` for a single
+/// impulse (unbounded).
+#[wasm_bindgen(js_name = klipperFigures)]
+pub fn klipper_figures(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+    #[derive(Deserialize)]
+    struct Options {
+        #[serde(default = "default_scv")]
+        scv: f64,
+    }
+    fn default_scv() -> f64 {
+        crate::smoothing::KLIPPER_SCV
+    }
+    let shaper = shaper_from_js(shaper).map_err(js_error)?;
+    let options: Options = if options.is_undefined() {
+        Options { scv: default_scv() }
+    } else {
+        from_js(options, "options").map_err(js_error)?
+    };
+    let figures = crate::smoothing::klipper_figures(&shaper, options.scv)
+        .map_err(|e| js_error(e.within("options")))?;
+    to_js(&figures)
+}

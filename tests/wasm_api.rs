@@ -113,3 +113,29 @@ fn errors_are_thrown_with_the_field_and_the_module_keeps_working() {
     // Still working after the errors.
     assert!(wasm::design(js(r#"{"family":"zv","modes":[{"frequencyHz":3}]}"#)).is_ok());
 }
+
+#[wasm_bindgen_test]
+fn exports_and_klipper_figures() {
+    let shaper = wasm::design(js(
+        r#"{"family":"zv","modes":[{"frequencyHz":2,"damping":0}]}"#,
+    ))
+    .unwrap();
+    let csv = wasm::export_shaper(shaper.clone(), js(r#"{"format":"csv"}"#)).unwrap();
+    assert_eq!(csv, "time_s,amplitude\n0,0.5\n0.25,0.5\n");
+    let rrf = wasm::export_shaper(shaper.clone(), js(r#"{"format":"rrf"}"#)).unwrap();
+    assert_eq!(rrf, "M593 P\"custom\" H0.5 T0.25");
+    let (message, field) =
+        error_message(wasm::export_shaper(shaper.clone(), js(r#"{"format":"xml"}"#)).unwrap_err());
+    assert_eq!(field.as_deref(), Some("options.format"), "{message}");
+    let (_, field) = error_message(
+        wasm::export_shaper(shaper.clone(), js(r#"{"format":"c","name":"9x"}"#)).unwrap_err(),
+    );
+    assert_eq!(field.as_deref(), Some("options.name"));
+    let figures = wasm::klipper_figures(shaper, JsValue::UNDEFINED).unwrap();
+    // ZV at 2 Hz, ζ = 0: d = 1/8 s; offset₁₈₀ = 5000·d²/2 = 39.0625 mm dominates offset₉₀.
+    let smoothing = get(&figures, "smoothing").as_f64().unwrap();
+    assert!((smoothing - 39.0625).abs() < 1e-9, "{smoothing}");
+    // At scv = 5 mm/s even a vanishing acceleration leaves offset₉₀ = √2·½·5·d = 0.44 mm > 0.12,
+    // so Klipper's find_shaper_max_accel returns 0 (its `_bisect` starts with func(1e-9)).
+    assert_eq!(get(&figures, "maxAccel").as_f64(), Some(0.0));
+}

@@ -1,0 +1,108 @@
+//! Klipper-compatible smoothing and maximum acceleration of a shaper.
+//!
+//! Klipper's `calibrate_shaper` reports, for each shaper, a "smoothing" figure (the positional
+//! offset in mm that the shaper introduces at a 90° or 180° corner at a given acceleration) and a
+//! suggested `max_accel` (the acceleration at which smoothing reaches 0.12 mm). Printer users
+//! compare shapers with these numbers, so we compute them with Klipper's own definitions
+//! (klippy/extras/shaper_calibrate.py, `_get_shaper_smoothing`, `find_shaper_max_accel`,
+//! `_bisect`, mainline Klipper3d/klipper), including its defaults: accel = 5000 mm/s²,
+//! square corner velocity scv = 5 mm/s, target smoothing 0.12 mm.
+//!
+//! With Aᵢ, tᵢ the shaper, D = Σ Aᵢ and t_s = Σ Aᵢtᵢ / D its centroid:
+//! - offset₉₀ = √2/D · Σ_{tᵢ ≥ t_s} Aᵢ (scv + a/2 (tᵢ − t_s)) (tᵢ − t_s)
+//! - offset₁₈₀ = 1/D · Σ Aᵢ a/2 (tᵢ − t_s)²
+//! - smoothing = max(offset₉₀, offset₁₈₀)
+
+use crate::error::{finite, Error, Result};
+use crate::shaper::Shaper;
+use serde::{Deserialize, Serialize};
+
+/// Klipper's default acceleration for the reported smoothing, mm/s².
+pub const KLIPPER_ACCEL: f64 = 5000.0;
+/// Klipper's default square corner velocity, mm/s.
+pub const KLIPPER_SCV: f64 = 5.0;
+/// Klipper's target smoothing for the suggested maximum acceleration, mm.
+pub const KLIPPER_TARGET_SMOOTHING: f64 = 0.12;
+
+/// Klipper's smoothing figures of a shaper.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct KlipperFigures {
+    /// Smoothing in mm at [`KLIPPER_ACCEL`] and the given scv.
+    pub smoothing: f64,
+    /// Suggested maximum acceleration in mm/s² (smoothing = 0.12 mm); 0 if even a tiny
+    /// acceleration exceeds it.
+    pub max_accel: f64,
+}
+
+/// Smoothing (mm) of `shaper` at acceleration `accel` (mm/s²) and square corner velocity `scv`
+/// (mm/s), as Klipper's `_get_shaper_smoothing`. Times are in seconds.
+pub fn smoothing(shaper: &Shaper, accel: f64, scv: f64) -> Result<f64> {
+    finite("accel", accel)?;
+    finite("scv", scv)?;
+    let d = shaper.amplitude_sum();
+    let ts = shaper.centroid_delay().ok_or_else(|| {
+        Error::invalid(
+            "impulses",
+            "the amplitudes sum to zero; smoothing is undefined",
+        )
+    })?;
+    let half = 0.5 * accel;
+    let (mut o90, mut o180) = (0.0, 0.0);
+    for imp in shaper.impulses() {
+        let dt = imp.time - ts;
+        if imp.time >= ts {
+            o90 += imp.amplitude * (scv + half * dt) * dt;
+        }
+        o180 += imp.amplitude * half * dt * dt;
+    }
+    Ok((o90 * std::f64::consts::SQRT_2 / d).max(o180 / d))
+}
+
+/// Klipper's suggested maximum acceleration: the largest `accel` with smoothing ≤ 0.12 mm,
+/// found by Klipper's own bisection (`_bisect`, to 1e-8 mm/s²), bounded to 4096 steps.
+///
+/// A shaper of zero duration (a single impulse) never smooths: its maximum acceleration is
+/// unbounded and `f64::INFINITY` is returned (`null` in JS).
+pub fn max_accel(shaper: &Shaper, scv: f64) -> Result<f64> {
+    if shaper.duration() == 0.0 {
+        finite("scv", scv)?;
+        return Ok(f64::INFINITY);
+    }
+    let ok =
+        |a: f64| -> Result<bool> { Ok(smoothing(shaper, a, scv)? <= KLIPPER_TARGET_SMOOTHING) };
+    if !ok(1e-9)? {
+        return Ok(0.0);
+    }
+    let (mut left, mut right) = (1.0_f64, 1.0_f64);
+    let mut steps = 0;
+    while !ok(left)? && steps < 4096 {
+        right = left;
+        left *= 0.5;
+        steps += 1;
+    }
+    if right == left {
+        while ok(right)? && steps < 4096 {
+            right *= 2.0;
+            steps += 1;
+        }
+    }
+    while right - left > 1e-8 && steps < 4096 {
+        let middle = 0.5 * (left + right);
+        if ok(middle)? {
+            left = middle;
+        } else {
+            right = middle;
+        }
+        steps += 1;
+    }
+    Ok(left)
+}
+
+/// Both figures at Klipper's defaults (accel 5000 mm/s² for smoothing), with `scv` in mm/s.
+pub fn klipper_figures(shaper: &Shaper, scv: f64) -> Result<KlipperFigures> {
+    Ok(KlipperFigures {
+        smoothing: smoothing(shaper, KLIPPER_ACCEL, scv)?,
+        max_accel: max_accel(shaper, scv)?,
+    })
+}
