@@ -126,12 +126,20 @@ pub fn families() -> Result<JsValue, JsValue> {
     to_js(&design::FAMILIES)
 }
 
+/// Most shapers the playground compares at once.
+const MAX_COMPARED: usize = 4;
+
 /// What the page shows, in one object (see [`render_playground`]).
 #[derive(Deserialize)]
 #[serde(rename_all = "camelCase")]
 struct PlaygroundState {
     modes: Vec<ModeSpec>,
-    shaper: ShaperSpec,
+    /// The shapers to compare (1 … 4).
+    #[serde(default)]
+    shapers: Vec<ShaperSpec>,
+    /// Shorthand for a single shaper (used when `shapers` is empty).
+    #[serde(default)]
+    shaper: Option<ShaperSpec>,
     #[serde(default)]
     view: PlaygroundView,
 }
@@ -145,6 +153,8 @@ struct PlaygroundView {
     points: usize,
     /// Tolerable vibration, fraction.
     vtol: f64,
+    /// Square corner velocity for Klipper's figures, mm/s.
+    scv: f64,
     /// Device pixel ratio the canvases were sized with.
     pixel_ratio: f64,
 }
@@ -156,14 +166,32 @@ impl Default for PlaygroundView {
             to_hz: None,
             points: 600,
             vtol: 0.05,
+            scv: crate::smoothing::KLIPPER_SCV,
             pixel_ratio: 1.0,
         }
     }
 }
 
+/// Everything the page shows about one shaper.
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct ShaperResult {
+    label: String,
+    family: &'static str,
+    shaper: ShaperData,
+    sensitivity: vibration::SensitivityCurve,
+    insensitivity: Vec<vibration::Insensitivity>,
+    residual_at_modes: Vec<f64>,
+    centroid_delay: Option<f64>,
+    klipper: crate::smoothing::KlipperFigures,
+}
+
 #[derive(Serialize)]
 #[serde(rename_all = "camelCase")]
 struct PlaygroundResult {
+    /// One entry per compared shaper, in order.
+    results: Vec<ShaperResult>,
+    // The first shaper's figures, as the single-shaper page had them.
     shaper: ShaperData,
     sensitivity: vibration::SensitivityCurve,
     insensitivity: Vec<vibration::Insensitivity>,
@@ -177,20 +205,55 @@ fn canvas(canvases: &JsValue, key: &str) -> Option<HtmlCanvasElement> {
         .and_then(|c| c.dyn_into::<HtmlCanvasElement>().ok())
 }
 
+/// Labels for the compared shapers: the family's title, numbered when repeated.
+fn labels(specs: &[ShaperSpec]) -> Vec<String> {
+    specs
+        .iter()
+        .enumerate()
+        .map(|(i, spec)| {
+            let title = spec.info().map_or("shaper", |f| f.title);
+            let repeated = specs.iter().filter(|s| s.name() == spec.name()).count() > 1;
+            if repeated {
+                format!("{title} #{}", i + 1)
+            } else {
+                title.to_string()
+            }
+        })
+        .collect()
+}
+
 /// `renderPlayground(state, canvases)`: everything one frame of the page needs, in one call.
 ///
-/// `state = { modes, shaper: { family, …parameters }, view: { fromHz, toHz, points, vtol,
-/// pixelRatio } }`; `canvases = { impulses?, sensitivity? }` (HTMLCanvasElements). Designs the
-/// shaper, computes its sensitivity curve (at the first mode's damping), insensitivity and
-/// residual vibration at each mode, draws the charts, and returns `{ shaper, sensitivity,
-/// insensitivity: [{ lowHz, highHz, width }], residualAtModes, centroidDelay }`. Nothing is
-/// drawn unless everything computed, so a bad input leaves the last good charts on screen.
+/// `state = { modes, shapers: [{ family, …parameters }] (1 … 4; or `shaper` for one),
+/// view: { fromHz, toHz, points, vtol, scv, pixelRatio } }`; `canvases = { impulses?,
+/// sensitivity? }` (HTMLCanvasElements). Designs every shaper, computes its sensitivity curve
+/// (at the first mode's damping), insensitivity and residual vibration at each mode and
+/// Klipper's smoothing figures, draws the charts overlaid, and returns `{ results: [{ label,
+/// family, shaper, sensitivity, insensitivity, residualAtModes, centroidDelay, klipper:
+/// { smoothing, maxAccel } }], …the first result's fields }`. Errors name the field
+/// (`shapers[1].vtol`, `modes[0].damping`, `view.vtol`). Nothing is drawn unless everything
+/// computed, so a bad input leaves the last good charts on screen.
 #[wasm_bindgen(js_name = renderPlayground)]
 pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, JsValue> {
     let state: PlaygroundState = from_js(state, "").map_err(js_error)?;
     let modes = Mode::list(&state.modes).map_err(js_error)?;
-    let shaper =
-        design::design_for(&state.shaper, &modes).map_err(|e| js_error(e.within("shaper")))?;
+    let mut specs = state.shapers;
+    if specs.is_empty() {
+        specs.extend(state.shaper);
+    }
+    if specs.is_empty() {
+        return Err(js_error(Error::invalid(
+            "shapers",
+            "at least one shaper is required",
+        )));
+    }
+    if specs.len() > MAX_COMPARED {
+        return Err(js_error(Error::TooLarge {
+            field: "shapers".into(),
+            value: specs.len() as f64,
+            limit: MAX_COMPARED as f64,
+        }));
+    }
     let view = &state.view;
     let f_max = modes.iter().map(Mode::frequency_hz).fold(0.0_f64, f64::max);
     let options = SensitivityOptions {
@@ -199,17 +262,36 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
         points: view.points,
         damping: modes[0].damping(),
     };
-    let curve =
-        vibration::sensitivity(&shaper, &options).map_err(|e| js_error(e.within("view")))?;
-    let insensitivity = modes
-        .iter()
-        .map(|m| vibration::insensitivity(&shaper, m, view.vtol))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| js_error(e.within("view")))?;
-    let residual_at_modes = modes
-        .iter()
-        .map(|m| vibration::residual_vibration(&shaper, m))
-        .collect();
+    let labels = labels(&specs);
+    let mut results = Vec::with_capacity(specs.len());
+    let mut shapers = Vec::with_capacity(specs.len());
+    for (k, spec) in specs.iter().enumerate() {
+        let at = |e: Error| js_error(e.within(&format!("shapers[{k}]")));
+        let shaper = design::design_for(spec, &modes).map_err(at)?;
+        let curve =
+            vibration::sensitivity(&shaper, &options).map_err(|e| js_error(e.within("view")))?;
+        let insensitivity = modes
+            .iter()
+            .map(|m| vibration::insensitivity(&shaper, m, view.vtol))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| js_error(e.within("view")))?;
+        let klipper = crate::smoothing::klipper_figures(&shaper, view.scv)
+            .map_err(|e| js_error(e.within("view")))?;
+        results.push(ShaperResult {
+            label: labels[k].clone(),
+            family: spec.name(),
+            shaper: shaper.to_data(),
+            sensitivity: curve,
+            insensitivity,
+            residual_at_modes: modes
+                .iter()
+                .map(|m| vibration::residual_vibration(&shaper, m))
+                .collect(),
+            centroid_delay: shaper.centroid_delay(),
+            klipper,
+        });
+        shapers.push(shaper);
+    }
     let style = ChartStyle {
         scale: if view.pixel_ratio.is_finite() && view.pixel_ratio > 0.0 {
             view.pixel_ratio
@@ -217,33 +299,42 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
             1.0
         },
     };
-    let label = state.shaper.info().map_or("shaper", |f| f.title);
-    if let Some(c) = canvas(&canvases, "impulses") {
-        if let Some(backend) = CanvasBackend::with_canvas_object(c) {
-            chart::draw_impulses(&backend.into_drawing_area(), &[(label, &shaper)], &style)
-                .map_err(js_error)?;
-        }
+    if let Some(backend) = canvas(&canvases, "impulses").and_then(CanvasBackend::with_canvas_object)
+    {
+        let series: Vec<(&str, &Shaper)> = labels
+            .iter()
+            .map(String::as_str)
+            .zip(shapers.iter())
+            .collect();
+        chart::draw_impulses(&backend.into_drawing_area(), &series, &style).map_err(js_error)?;
     }
-    if let Some(c) = canvas(&canvases, "sensitivity") {
-        if let Some(backend) = CanvasBackend::with_canvas_object(c) {
-            let modes_hz: Vec<f64> = modes.iter().map(Mode::frequency_hz).collect();
-            chart::draw_sensitivity(
-                &backend.into_drawing_area(),
-                &[(label, &curve)],
-                Some(view.vtol),
-                &modes_hz,
-                &style,
-            )
-            .map_err(js_error)?;
-        }
+    if let Some(backend) =
+        canvas(&canvases, "sensitivity").and_then(CanvasBackend::with_canvas_object)
+    {
+        let modes_hz: Vec<f64> = modes.iter().map(Mode::frequency_hz).collect();
+        let series: Vec<(&str, &vibration::SensitivityCurve)> = results
+            .iter()
+            .map(|r| (r.label.as_str(), &r.sensitivity))
+            .collect();
+        chart::draw_sensitivity(
+            &backend.into_drawing_area(),
+            &series,
+            Some(view.vtol),
+            &modes_hz,
+            &style,
+        )
+        .map_err(js_error)?;
     }
-    to_js(&PlaygroundResult {
-        shaper: shaper.to_data(),
-        sensitivity: curve,
-        insensitivity,
-        residual_at_modes,
-        centroid_delay: shaper.centroid_delay(),
-    })
+    let first = &results[0];
+    let result = PlaygroundResult {
+        shaper: first.shaper.clone(),
+        sensitivity: first.sensitivity.clone(),
+        insensitivity: first.insensitivity.clone(),
+        residual_at_modes: first.residual_at_modes.clone(),
+        centroid_delay: first.centroid_delay,
+        results,
+    };
+    to_js(&result)
 }
 
 /// Options of [`export_shaper`].

@@ -1,35 +1,223 @@
-// The page: reads the controls, makes one call into wasm per update (renderPlayground), shows
-// the numbers, and on a bad value shows the message next to its field while the last good
-// charts and numbers stay.
-import init, { renderPlayground, families } from '../pkg/input_shaping.js';
+// The playground: one state object (state.js), editors built from it, one call into wasm per
+// frame (renderPlayground), and the numbers, charts and exports of the last good result. A bad
+// value shows its message next to its field (matched by the error's `field` against the
+// inputs' data-field) while the last good charts and numbers stay.
+import init, { renderPlayground, families, exportShaper } from '../pkg/input_shaping.js';
+import { DEFAULT_STATE, PRESETS, MAX_MODES, MAX_SHAPERS, checkState, clone, toHash, fromHash } from './state.js';
+import { paramInfo, parseParam, formatParam } from './params.js';
 
 const $ = (id) => document.getElementById(id);
+const COLORS = ['#0072b2', '#d55e00', '#009e73', '#cc79a7'];
 
-// Which input a core error's `field` belongs to.
-const FIELD_INPUT = [
-  [/^modes\[0\]\.frequencyHz/, 'frequency'],
-  [/^modes\[0\]\.damping/, 'damping'],
-  [/^(shaper\.)?derivatives/, 'derivatives'],
-  [/^(shaper\.)?family|^shaper$/, 'family'],
-  [/^view\.vtol|^vtol/, 'vtol'],
-];
+let state = clone(DEFAULT_STATE);
+let familyTable = [];
+let lastGood = null; // { state, result }
 
-function readNumber(id) {
-  const text = $(id).value.trim();
-  return text === '' ? NaN : Number(text);
+// ---------- small DOM helpers (text only: user text never reaches innerHTML) ----------
+function el(tag, props = {}, ...children) {
+  const node = document.createElement(tag);
+  for (const [k, v] of Object.entries(props)) {
+    if (k === 'dataset') Object.assign(node.dataset, v);
+    else if (k in node && typeof v !== 'string') node[k] = v;
+    else node.setAttribute(k, v);
+  }
+  node.append(...children.filter((c) => c !== null && c !== undefined));
+  return node;
 }
 
-function readState() {
-  const family = $('family').value;
-  const shaper = { family };
-  if (family === 'zvdn') shaper.derivatives = readNumber('derivatives');
-  return {
-    modes: [{ frequencyHz: readNumber('frequency'), damping: readNumber('damping') }],
-    shaper,
-    view: { vtol: readNumber('vtol') / 100, pixelRatio: window.devicePixelRatio || 1 },
+const fmt = (x, digits = 6) => (Number.isFinite(x) ? String(Number(x.toPrecision(digits))) : '—');
+/** A vibration in %, with rounding-level values (below 1e-9 %) shown as ≈ 0. */
+const fmtPct = (fraction) => (Math.abs(fraction) < 1e-11 ? '≈ 0' : fmt(fraction * 100, 4));
+const readNumber = (input) => (input.value.trim() === '' ? NaN : Number(input.value));
+
+// Frequency sliders are logarithmic: 0.01 Hz … 1 kHz over 0 … 1000.
+const F_MIN = 0.01;
+const F_DECADES = 5;
+const sliderToHz = (v) => F_MIN * 10 ** ((F_DECADES * v) / 1000);
+const hzToSlider = (f) => Math.min(1000, Math.max(0, (1000 * Math.log10(f / F_MIN)) / F_DECADES));
+
+// ---------- editors ----------
+function field(labelText, input, extra = null) {
+  const id = input.id;
+  return el('div', { class: 'field' }, el('label', { for: id }, labelText), extra ?? input, el('span', { class: 'error', role: 'alert' }));
+}
+
+function modeRow(mode, i) {
+  const f = el('input', { id: `mode-${i}-frequency`, type: 'number', step: 'any', value: String(mode.frequencyHz ?? ''), dataset: { field: `modes[${i}].frequencyHz` }, inputmode: 'decimal' });
+  const fSlider = el('input', { type: 'range', min: '0', max: '1000', step: '1', 'aria-label': `Mode ${i + 1} frequency (logarithmic slider)` });
+  const z = el('input', { id: `mode-${i}-damping`, type: 'number', step: 'any', value: String(mode.damping ?? ''), dataset: { field: `modes[${i}].damping` }, inputmode: 'decimal' });
+  const zSlider = el('input', { type: 'range', min: '0', max: '0.5', step: '0.001', 'aria-label': `Mode ${i + 1} damping ratio slider` });
+  const omega = el('output', { for: f.id, class: 'hint' });
+  const syncSliders = () => {
+    const fv = readNumber(f);
+    if (Number.isFinite(fv) && fv > 0) fSlider.value = String(hzToSlider(fv));
+    const zv = readNumber(z);
+    if (Number.isFinite(zv)) zSlider.value = String(zv);
+    omega.textContent = Number.isFinite(fv) ? `ω = ${fmt(2 * Math.PI * fv, 5)} rad/s` : '';
   };
+  syncSliders();
+  f.addEventListener('input', () => { state.modes[i].frequencyHz = readNumber(f); syncSliders(); changed(); });
+  z.addEventListener('input', () => { state.modes[i].damping = readNumber(z); syncSliders(); changed(); });
+  fSlider.addEventListener('input', () => {
+    const hz = Number(sliderToHz(Number(fSlider.value)).toPrecision(4));
+    f.value = String(hz);
+    state.modes[i].frequencyHz = hz;
+    syncSliders();
+    changed();
+  });
+  zSlider.addEventListener('input', () => { z.value = zSlider.value; state.modes[i].damping = Number(zSlider.value); syncSliders(); changed(); });
+  const remove = el('button', { type: 'button', class: 'remove', 'aria-label': `Remove mode ${i + 1}`, disabled: state.modes.length <= 1 }, '×');
+  remove.addEventListener('click', () => { state.modes.splice(i, 1); rebuild(); changed(true); });
+  return el('div', { class: 'card mode', dataset: { fieldGroup: `modes[${i}]` } },
+    el('div', { class: 'card-head' }, el('strong', {}, `Mode ${i + 1}`), remove),
+    field('Frequency (Hz)', f, el('div', { class: 'pair' }, fSlider, f)),
+    omega,
+    field('Damping ratio ζ', z, el('div', { class: 'pair' }, zSlider, z)));
 }
 
+function shaperCard(spec, k) {
+  const family = el('select', { id: `shaper-${k}-family`, dataset: { field: `shapers[${k}].family` } },
+    ...familyTable.map((f) => el('option', { value: f.name }, f.title)));
+  family.value = spec.family;
+  if (family.value !== spec.family) {
+    family.prepend(el('option', { value: spec.family }, spec.family));
+    family.value = spec.family;
+  }
+  const info = familyTable.find((f) => f.name === spec.family);
+  family.addEventListener('change', () => {
+    const next = { family: family.value };
+    const nextInfo = familyTable.find((f) => f.name === family.value);
+    for (const p of nextInfo?.parameters ?? []) next[p] = spec[p] ?? paramInfo(p).default;
+    state.shapers[k] = next;
+    rebuild();
+    changed(true);
+  });
+  const params = (info?.parameters ?? []).map((name) => {
+    const pinfo = paramInfo(name);
+    if (!(name in spec)) spec[name] = pinfo.default;
+    let input;
+    if (pinfo.kind === 'select') {
+      input = el('select', { id: `shaper-${k}-${name}`, dataset: { field: `shapers[${k}].${name}` } },
+        ...pinfo.options.map((o) => el('option', { value: o }, o)));
+      input.value = spec[name];
+    } else {
+      input = el('input', {
+        id: `shaper-${k}-${name}`, type: pinfo.kind === 'numbers' ? 'text' : 'number', step: pinfo.kind === 'integer' ? '1' : 'any',
+        value: formatParam(pinfo, spec[name]), dataset: { field: `shapers[${k}].${name}` },
+      });
+      if (pinfo.min !== undefined) input.min = String(pinfo.min);
+      if (pinfo.max !== undefined) input.max = String(pinfo.max);
+    }
+    input.addEventListener('input', () => { spec[name] = parseParam(pinfo, input.value); changed(); });
+    const f = field(pinfo.label, input);
+    if (pinfo.help) f.append(el('span', { class: 'hint' }, pinfo.help));
+    return f;
+  });
+  const remove = el('button', { type: 'button', class: 'remove', 'aria-label': `Remove shaper ${k + 1}`, disabled: state.shapers.length <= 1 }, '×');
+  remove.addEventListener('click', () => { state.shapers.splice(k, 1); rebuild(); changed(true); });
+  return el('div', { class: 'card shaper', dataset: { fieldGroup: `shapers[${k}]` } },
+    el('div', { class: 'card-head' }, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), el('strong', {}, `Shaper ${k + 1}`), remove),
+    field('Family', family),
+    el('span', { class: 'hint' }, info ? `${info.guarantee}. ${info.source}` : ''),
+    ...params,
+    el('span', { class: 'error group-error', role: 'alert' }));
+}
+
+function rebuild() {
+  $('modes').replaceChildren(...state.modes.map(modeRow));
+  $('shapers').replaceChildren(...state.shapers.map(shaperCard));
+  $('add-mode').disabled = state.modes.length >= MAX_MODES;
+  $('add-shaper').disabled = state.shapers.length >= MAX_SHAPERS;
+  $('vtol').value = formatParam({ kind: 'percent' }, state.view.vtol);
+  $('scv').value = String(state.view.scv ?? '');
+}
+
+// ---------- errors ----------
+function clearErrors() {
+  for (const e of document.querySelectorAll('#controls .error')) e.textContent = '';
+  for (const e of document.querySelectorAll('[aria-invalid]')) e.removeAttribute('aria-invalid');
+  $('general-error').textContent = '';
+}
+
+/** Shows a core error next to the input it names (or the closest group), else on top. */
+function showError(error) {
+  const message = error?.message ?? String(error);
+  let path = typeof error?.field === 'string' ? error.field : '';
+  while (path) {
+    const input = document.querySelector(`[data-field="${CSS.escape(path)}"]`);
+    if (input) {
+      input.setAttribute('aria-invalid', 'true');
+      input.closest('.field').querySelector('.error').textContent = message;
+      return;
+    }
+    const group = document.querySelector(`[data-field-group="${CSS.escape(path)}"]`);
+    if (group) {
+      group.querySelector('.group-error, .error').textContent = message;
+      return;
+    }
+    path = path.replace(/(\.[^.[\]]*|\[\d+\])$/, '');
+  }
+  $('general-error').textContent = message;
+}
+
+// ---------- results ----------
+function showResults(result, st) {
+  const { results } = result;
+  const head = el('tr', {}, el('th', { scope: 'col' }, ''),
+    ...results.map((r, k) => el('th', { scope: 'col' }, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), r.label)));
+  $('summary').tHead.replaceChildren(head);
+  const period = 1 / (st.modes[0].frequencyHz * Math.sqrt(1 - st.modes[0].damping ** 2));
+  const vtolPct = fmt(st.view.vtol * 100, 4);
+  const rows = [
+    ['Impulses', (r) => String(r.shaper.impulses.length)],
+    ['Duration (s)', (r) => fmt(r.shaper.duration)],
+    ['Duration (damped periods of mode 1)', (r) => fmt(r.shaper.duration / period, 4)],
+    ['Centroid delay (s)', (r) => (r.centroidDelay == null ? '—' : fmt(r.centroidDelay))],
+  ];
+  st.modes.forEach((m, i) => {
+    const tag = st.modes.length > 1 ? ` at mode ${i + 1}` : '';
+    rows.push([`Insensitivity I(${vtolPct} %)${tag}`, (r) => fmt(r.insensitivity[i].width, 4)]);
+    rows.push([`Band with V ≤ ${vtolPct} %${tag} (Hz)`, (r) => `${fmt(r.insensitivity[i].lowHz, 5)} – ${fmt(r.insensitivity[i].highHz, 5)}`]);
+    rows.push([`Residual vibration${tag} (%)`, (r) => fmtPct(r.residualAtModes[i])]);
+  });
+  rows.push(['Klipper smoothing at 5000 mm/s² (mm)', (r) => fmt(r.klipper.smoothing, 4)]);
+  rows.push(['Klipper max accel (mm/s²)', (r) => (r.klipper.maxAccel == null ? '∞' : fmt(r.klipper.maxAccel, 5))]);
+  $('summary').tBodies[0].replaceChildren(...rows.map(([name, f]) => el('tr', {},
+    el('th', { scope: 'row' }, name), ...results.map((r) => el('td', {}, f(r))))));
+
+  $('impulse-tables').replaceChildren(...results.map((r, k) => el('table', { class: 'impulses', id: `impulses-${k}` },
+    el('caption', {}, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), r.label),
+    el('thead', {}, el('tr', {}, el('th', { scope: 'col' }, '#'), el('th', { scope: 'col' }, 'time (s)'), el('th', { scope: 'col' }, 'amplitude'))),
+    el('tbody', {}, ...r.shaper.impulses.map((imp, i) => el('tr', {},
+      el('td', {}, String(i + 1)), el('td', {}, fmt(imp.time, 10)), el('td', {}, fmt(imp.amplitude, 10))))))));
+
+  const sel = $('export-shaper');
+  const keep = sel.value;
+  sel.replaceChildren(...results.map((r, k) => el('option', { value: String(k) }, r.label)));
+  sel.value = keep && Number(keep) < results.length ? keep : '0';
+  showExport();
+}
+
+function showExport() {
+  $('export-error').textContent = '';
+  if (!lastGood) return;
+  const k = Number($('export-shaper').value) || 0;
+  const r = lastGood.result.results[k];
+  if (!r) return;
+  const m = lastGood.state.modes.map((mode) => `${mode.frequencyHz} Hz, ζ ${mode.damping}`).join('; ');
+  try {
+    $('export-output').value = exportShaper(r.shaper, {
+      format: $('export-format').value,
+      name: 'shaper',
+      comment: `input-shaping: ${r.label} for ${m}`,
+    });
+  } catch (e) {
+    $('export-output').value = '';
+    $('export-error').textContent = e.message;
+  }
+}
+
+// ---------- update loop ----------
 function sizeCanvas(canvas) {
   const ratio = window.devicePixelRatio || 1;
   const w = Math.max(1, Math.round(canvas.clientWidth * ratio));
@@ -40,111 +228,127 @@ function sizeCanvas(canvas) {
   }
 }
 
-function clearErrors() {
-  for (const el of document.querySelectorAll('.error')) el.textContent = '';
-  for (const el of document.querySelectorAll('[aria-invalid]')) el.removeAttribute('aria-invalid');
-}
-
-function showError(error) {
-  const field = error && typeof error.field === 'string' ? error.field : '';
-  const message = error && error.message ? error.message : String(error);
-  const match = FIELD_INPUT.find(([re]) => re.test(field));
-  const id = match ? match[1] : null;
-  if (id) {
-    $(`${id}-error`).textContent = message;
-    $(id).setAttribute('aria-invalid', 'true');
-  } else {
-    $('general-error').textContent = message;
-  }
-}
-
-const fmt = (x, digits = 6) => (Number.isFinite(x) ? Number(x.toPrecision(digits)).toString() : '—');
-
-function showNumbers(result, state) {
-  const { shaper, insensitivity, centroidDelay } = result;
-  $('duration').textContent = `${fmt(shaper.duration)} s`;
-  $('delay').textContent = centroidDelay == null ? '—' : `${fmt(centroidDelay)} s`;
-  const band = insensitivity[0];
-  const vtolPct = fmt(state.view.vtol * 100, 4);
-  $('insensitivity-label').textContent = `Insensitivity I(${vtolPct} %)`;
-  $('insensitivity').textContent = fmt(band.width, 4);
-  $('band').textContent = `${fmt(band.lowHz, 5)} – ${fmt(band.highHz, 5)} Hz`;
-  const body = $('impulses').tBodies[0];
-  body.replaceChildren(
-    ...shaper.impulses.map((imp, i) => {
-      const row = document.createElement('tr');
-      for (const text of [String(i + 1), fmt(imp.time, 8), fmt(imp.amplitude, 8)]) {
-        const td = document.createElement('td');
-        td.textContent = text;
-        row.append(td);
-      }
-      return row;
-    }),
-  );
-}
-
-function showOmega() {
-  const f = readNumber('frequency');
-  $('omega').textContent = Number.isFinite(f) ? `ω = ${fmt(2 * Math.PI * f, 5)} rad/s` : '';
-}
-
+/** Recomputes and redraws everything; returns the time it took in ms (for the benchmark). */
 function update() {
+  const t0 = performance.now();
   clearErrors();
-  showOmega();
-  $('derivatives-field').hidden = $('family').value !== 'zvdn';
-  const info = familyTable.find((f) => f.name === $('family').value);
-  $('family-guarantee').textContent = info ? `${info.guarantee} (${info.source})` : '';
-  const state = readState();
   const canvases = { impulses: $('impulses-chart'), sensitivity: $('sensitivity-chart') };
   Object.values(canvases).forEach(sizeCanvas);
+  const st = { ...state, view: { ...state.view, pixelRatio: window.devicePixelRatio || 1 } };
   try {
-    const result = renderPlayground(state, canvases);
-    showNumbers(result, state);
+    const result = renderPlayground(st, canvases);
+    lastGood = { state: clone(state), result };
+    showResults(result, state);
     document.body.dataset.ready = 'true';
   } catch (error) {
     showError(error);
   }
+  return performance.now() - t0;
 }
 
-// Keeps each slider and its number field in step.
-function pair(sliderId, inputId) {
-  $(sliderId).addEventListener('input', () => {
-    $(inputId).value = $(sliderId).value;
-    update();
-  });
-  $(inputId).addEventListener('input', () => {
-    const v = readNumber(inputId);
-    if (Number.isFinite(v)) $(sliderId).value = String(v);
-    update();
-  });
+let frame = 0;
+let editing = false;
+/** Schedules one update for the next frame and records the state in the URL. */
+function changed(commit = false) {
+  const hash = toHash(state);
+  if (hash !== location.hash) {
+    // One history entry per editing gesture: push at its start, replace while it goes on.
+    if (!editing || commit) history.pushState(null, '', hash);
+    else history.replaceState(null, '', hash);
+    editing = !commit;
+  }
+  if (!frame) frame = requestAnimationFrame(() => { frame = 0; update(); });
 }
 
-let familyTable = [];
+function loadState(next, { push = true } = {}) {
+  state = next;
+  rebuild();
+  if (push) changed(true);
+  else update();
+}
+
+function notice(text) {
+  $('notice').textContent = text;
+}
+
+/** Loads the state in the URL hash; a garbled one is refused with a message and the current
+ * (or, on first load, the default) state is kept. */
+function fromLocation({ startup = false } = {}) {
+  const { state: s, error } = fromHash(location.hash);
+  if (error) {
+    if (startup) loadState(clone(DEFAULT_STATE), { push: false });
+    $('general-error').textContent = error;
+    return;
+  }
+  if (s && lastGood && JSON.stringify(s) === JSON.stringify(state)) return;
+  loadState(s ?? clone(DEFAULT_STATE), { push: false });
+}
 
 async function main() {
   await init();
   familyTable = families();
-  $('family').replaceChildren(
-    ...familyTable.map((f) => {
-      const option = document.createElement('option');
-      option.value = f.name;
-      option.textContent = f.title;
-      return option;
-    }),
-  );
-  $('family').value = 'zvd';
-  pair('frequency-slider', 'frequency');
-  pair('damping-slider', 'damping');
-  for (const id of ['family', 'derivatives', 'vtol']) $(id).addEventListener('input', update);
-  $('controls').addEventListener('submit', (e) => e.preventDefault());
-  let resizeTimer;
-  window.addEventListener('resize', () => {
-    clearTimeout(resizeTimer);
-    resizeTimer = setTimeout(update, 100);
+  $('preset').append(...PRESETS.map((p) => el('option', { value: p.id }, p.title)));
+  $('preset').addEventListener('change', () => {
+    const p = PRESETS.find((x) => x.id === $('preset').value);
+    if (p) loadState(clone(p.state));
   });
-  update();
+  $('add-mode').addEventListener('click', () => {
+    const last = state.modes[state.modes.length - 1];
+    state.modes.push({ frequencyHz: Number(((last?.frequencyHz || 1) * 2.5).toPrecision(4)), damping: last?.damping ?? 0.02 });
+    rebuild();
+    changed(true);
+  });
+  $('add-shaper').addEventListener('click', () => {
+    const used = new Set(state.shapers.map((s) => s.family));
+    const next = familyTable.find((f) => !used.has(f.name) && f.parameters.length === 0) ?? familyTable[0];
+    state.shapers.push({ family: next.name });
+    rebuild();
+    changed(true);
+  });
+  $('vtol').addEventListener('input', () => { state.view.vtol = parseParam({ kind: 'percent' }, $('vtol').value); changed(); });
+  $('scv').addEventListener('input', () => { state.view.scv = readNumber($('scv')); changed(); });
+  $('controls').addEventListener('change', () => { editing = false; });
+  $('controls').addEventListener('submit', (e) => e.preventDefault());
+  $('export-shaper').addEventListener('change', showExport);
+  $('export-format').addEventListener('change', showExport);
+  $('export-copy').addEventListener('click', () => navigator.clipboard?.writeText($('export-output').value).then(() => notice('Export copied.'), () => notice('Copy failed: select the text and copy it.')));
+  $('export-download').addEventListener('click', () => {
+    const ext = { csv: 'csv', json: 'json', c: 'h', rrf: 'g' }[$('export-format').value];
+    download(`shaper.${ext}`, $('export-output').value);
+  });
+  $('copy-link').addEventListener('click', () => navigator.clipboard?.writeText(location.href).then(() => notice('Link copied.'), () => notice('Copy failed: copy the address bar.')));
+  $('save-state').addEventListener('click', () => download('input-shaping-state.json', JSON.stringify(state, null, 2)));
+  $('load-state').addEventListener('change', async () => {
+    const file = $('load-state').files[0];
+    $('load-state').value = '';
+    if (!file) return;
+    try {
+      if (file.size > 100000) throw new Error('The file is too large to be a playground state.');
+      const next = checkState(JSON.parse(await file.text()));
+      loadState(next);
+      notice(`Loaded ${file.name}.`);
+    } catch (e) {
+      $('general-error').textContent = `Could not load ${file.name}: ${e.message}`;
+    }
+  });
+  window.addEventListener('popstate', () => fromLocation());
+  window.addEventListener('hashchange', () => fromLocation());
+  let resizeTimer;
+  window.addEventListener('resize', () => { clearTimeout(resizeTimer); resizeTimer = setTimeout(update, 100); });
+  fromLocation({ startup: true });
+  // For the benchmark script: a full update, timed.
+  window.__playground = { update, get state() { return state; } };
+}
+
+function download(name, text) {
+  const url = URL.createObjectURL(new Blob([text], { type: 'text/plain' }));
+  const a = el('a', { href: url, download: name });
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
 main().catch((error) => {
-  $('general-error').textContent = `The page could not start: ${error.message ?? error}`;
+  $('general-error').textContent = `The page could not start: ${error?.message ?? error}`;
 });

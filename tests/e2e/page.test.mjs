@@ -1,5 +1,6 @@
-// End-to-end: the built page in headless Chromium. Numbers in the DOM against the closed
-// forms, pixels on the canvases, the error path, no console errors, and screenshots.
+// End-to-end: the built page in headless Chromium. Numbers in the DOM against closed forms
+// computed here (independently of the wasm), pixels on the canvases, the error paths, the URL
+// state, exports, no console errors, and screenshots.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { openBrowser, canvasInfo, type, SCREENSHOTS } from './browser.mjs';
@@ -8,7 +9,7 @@ let env;
 before(async () => { env = await openBrowser(); });
 after(async () => { await env?.close(); });
 
-/** ZVD with damping, Singhose 2009 eq. 17 — computed here independently of the wasm. */
+/** ZVD with damping, Singhose 2009 eq. 17. */
 function zvd(f, z) {
   const k = Math.exp((-z * Math.PI) / Math.sqrt(1 - z * z));
   const td = 1 / (f * Math.sqrt(1 - z * z));
@@ -16,9 +17,16 @@ function zvd(f, z) {
   return [[0, 1 / d], [td / 2, (2 * k) / d], [td, (k * k) / d]];
 }
 
-async function impulseRows(page) {
-  return page.$$eval('#impulses tbody tr', (rows) => rows.map((r) => [...r.cells].slice(1).map((c) => Number(c.textContent))));
+async function impulseRows(page, k = 0) {
+  return page.$$eval(`#impulses-${k} tbody tr`, (rows) => rows.map((r) => [...r.cells].slice(1).map((c) => Number(c.textContent))));
 }
+
+/** The numbers table as { rowName: [cell per shaper] }. */
+async function summary(page) {
+  return page.$$eval('#summary tbody tr', (rows) => Object.fromEntries(rows.map((r) => [r.cells[0].textContent, [...r.cells].slice(1).map((c) => c.textContent)])));
+}
+
+const settle = (page) => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
 
 test('the default page shows the ZVD shaper of the closed form and draws both charts', async () => {
   const { page, problems } = await env.page();
@@ -26,11 +34,12 @@ test('the default page shows the ZVD shaper of the closed form and draws both ch
   const want = zvd(2, 0.05);
   assert.equal(rows.length, 3);
   rows.forEach(([t, a], i) => {
-    assert.ok(Math.abs(t - want[i][0]) < 1e-6, `time ${i}: ${t} vs ${want[i][0]}`);
-    assert.ok(Math.abs(a - want[i][1]) < 1e-6, `amplitude ${i}: ${a} vs ${want[i][1]}`);
+    assert.ok(Math.abs(t - want[i][0]) < 1e-9, `time ${i}: ${t} vs ${want[i][0]}`);
+    assert.ok(Math.abs(a - want[i][1]) < 1e-9, `amplitude ${i}: ${a} vs ${want[i][1]}`);
   });
-  assert.equal(await page.textContent('#duration'), `${Number(want[2][0].toPrecision(6))} s`);
-  assert.equal(await page.isVisible('#derivatives'), false, 'n is only asked for ZV-Dⁿ');
+  const s = await summary(page);
+  assert.deepEqual(s['Duration (s)'], [String(Number(want[2][0].toPrecision(6)))]);
+  assert.deepEqual(s['Duration (damped periods of mode 1)'], ['1']);
   for (const id of ['impulses-chart', 'sensitivity-chart']) {
     const info = await canvasInfo(page, id);
     assert.ok(info.ink > 2000, `${id} has ink: ${info.ink} px of ${info.width}x${info.height}`);
@@ -40,21 +49,83 @@ test('the default page shows the ZVD shaper of the closed form and draws both ch
   await page.close();
 });
 
-test('changing the mode and family changes the numbers as the core predicts', async () => {
+test('changing a mode and the family changes the numbers as the core predicts', async () => {
   const { page, problems } = await env.page();
-  await page.selectOption('#family', 'zv');
-  await type(page, 'frequency', 10);
-  await type(page, 'damping', 0);
-  await page.waitForFunction(() => document.querySelectorAll('#impulses tbody tr').length === 2);
-  const rows = await impulseRows(page);
-  assert.deepEqual(rows, [[0, 0.5], [0.05, 0.5]]);
+  await page.selectOption('#shaper-0-family', 'zv');
+  await type(page, 'mode-0-frequency', 10);
+  await type(page, 'mode-0-damping', 0);
+  await settle(page);
+  assert.deepEqual(await impulseRows(page), [[0, 0.5], [0.05, 0.5]]);
   // ZV at ζ = 0: I(5 %) = 2 − 4·acos(0.05)/π = 0.06369 (Singhose 2009 Fig. 7: 0.06).
-  assert.equal(await page.textContent('#insensitivity'), '0.06369');
-  assert.match(await page.textContent('#omega'), /62\.832 rad\/s/);
-  await page.selectOption('#family', 'zvdn');
-  assert.equal(await page.isVisible('#derivatives'), true);
-  await type(page, 'derivatives', 4);
-  await page.waitForFunction(() => document.querySelectorAll('#impulses tbody tr').length === 6);
+  const s = await summary(page);
+  assert.deepEqual(s['Insensitivity I(5 %)'], ['0.06369']);
+  assert.match(await page.textContent('.mode output'), /62\.832 rad\/s/);
+  await page.selectOption('#shaper-0-family', 'zvdn');
+  assert.equal(await page.isVisible('#shaper-0-derivatives'), true);
+  await type(page, 'shaper-0-derivatives', 4);
+  await settle(page);
+  assert.equal((await impulseRows(page)).length, 6);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('modes can be added and removed, shapers compared', async () => {
+  const { page, problems } = await env.page();
+  await page.click('#add-mode');
+  await settle(page);
+  assert.equal(await page.locator('.mode').count(), 2);
+  // Two modes by convolution: ZVD ⊗ ZVD = 9 impulses (Singer & Seering 1988 §2.3).
+  assert.equal((await impulseRows(page)).length, 9);
+  const s = await summary(page);
+  assert.ok('Insensitivity I(5 %) at mode 2' in s);
+  await page.click('#add-shaper');
+  await settle(page);
+  assert.equal(await page.locator('.shaper').count(), 2);
+  assert.equal((await summary(page))['Impulses'].length, 2);
+  for (let i = 0; i < 4; i++) await page.click('#add-mode').catch(() => {});
+  assert.equal(await page.locator('.mode').count(), 6);
+  assert.equal(await page.isDisabled('#add-mode'), true);
+  await page.click('button[aria-label="Remove mode 6"]');
+  await page.click('button[aria-label="Remove mode 5"]');
+  await page.click('button[aria-label="Remove mode 4"]');
+  await page.click('button[aria-label="Remove mode 3"]');
+  await page.click('button[aria-label="Remove mode 2"]');
+  await settle(page);
+  assert.equal(await page.locator('.mode').count(), 1);
+  assert.equal(await page.isDisabled('button[aria-label="Remove mode 1"]'), true);
+  await page.screenshot({ path: `${SCREENSHOTS}compare-1280x800.png`, fullPage: true });
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('every family is selectable and draws', async () => {
+  const { page, problems } = await env.page();
+  const names = await page.$$eval('#shaper-0-family option', (o) => o.map((x) => x.value));
+  assert.ok(names.length >= 4, names.join());
+  for (const name of names) {
+    await page.selectOption('#shaper-0-family', name);
+    await settle(page);
+    const errors = await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
+    assert.deepEqual(errors, [], `family ${name} with its default parameters`);
+    assert.ok((await impulseRows(page)).length >= 1, name);
+    assert.ok((await canvasInfo(page, 'sensitivity-chart')).ink > 1000, name);
+  }
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('every preset loads and draws', async () => {
+  const { page, problems } = await env.page();
+  const ids = await page.$$eval('#preset option', (o) => o.map((x) => x.value).filter(Boolean));
+  assert.ok(ids.length >= 3);
+  for (const id of ids) {
+    await page.selectOption('#preset', id);
+    await settle(page);
+    const errors = await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
+    assert.deepEqual(errors, [], `preset ${id}`);
+    assert.ok((await canvasInfo(page, 'impulses-chart')).ink > 1000, id);
+    await page.screenshot({ path: `${SCREENSHOTS}preset-${id}.png`, fullPage: true });
+  }
   assert.deepEqual(problems, []);
   await page.close();
 });
@@ -66,28 +137,93 @@ test('a bad value shows a message at its field and keeps the last good result', 
     sens: await canvasInfo(page, 'sensitivity-chart'),
     rows: await impulseRows(page),
   };
-  await type(page, 'damping', 1.5);
-  const message = await page.textContent('#damping-error');
+  await type(page, 'mode-0-damping', 1.5);
+  await settle(page);
+  const message = await page.textContent('[data-field="modes[0].damping"] ~ .error, .field:has([data-field="modes[0].damping"]) .error');
   assert.match(message, /damping/);
   assert.match(message, /1\.5/);
-  assert.equal(await page.getAttribute('#damping', 'aria-invalid'), 'true');
-  assert.equal(await page.textContent('#frequency-error'), '');
+  assert.equal(await page.getAttribute('#mode-0-damping', 'aria-invalid'), 'true');
   assert.deepEqual(await impulseRows(page), before.rows);
   assert.equal((await canvasInfo(page, 'impulses-chart')).hash, before.imp.hash);
   assert.equal((await canvasInfo(page, 'sensitivity-chart')).hash, before.sens.hash);
   await page.screenshot({ path: `${SCREENSHOTS}error-1280x800.png`, fullPage: true });
 
-  await type(page, 'frequency', -4);
-  assert.match(await page.textContent('#frequency-error'), /greater than 0/);
-  await type(page, 'frequency', '');
-  assert.match(await page.textContent('#frequency-error'), /finite/);
-  await type(page, 'frequency', 2);
-  await type(page, 'damping', 0.05);
-  assert.equal(await page.textContent('#damping-error'), '');
-  assert.equal(await page.getAttribute('#damping', 'aria-invalid'), null);
+  await type(page, 'mode-0-frequency', -4);
+  await settle(page);
+  assert.match(await page.textContent('.field:has(#mode-0-frequency) .error'), /greater than 0/);
+  await type(page, 'mode-0-frequency', '');
+  await settle(page);
+  assert.match(await page.textContent('.field:has(#mode-0-frequency) .error'), /finite/);
+  await type(page, 'mode-0-frequency', 2);
+  await type(page, 'mode-0-damping', 0.05);
+  await settle(page);
+  assert.equal(await page.$$eval('.error', (e) => e.map((x) => x.textContent).join('')), '');
   await type(page, 'vtol', 150);
-  assert.match(await page.textContent('#vtol-error'), /below 1/);
+  await settle(page);
+  assert.match(await page.textContent('.field:has(#vtol) .error'), /below 1/);
+  await type(page, 'vtol', 5);
+  await page.selectOption('#shaper-0-family', 'zvdn');
+  await type(page, 'shaper-0-derivatives', 99);
+  await settle(page);
+  assert.match(await page.textContent('.field:has(#shaper-0-derivatives) .error'), /too large/);
   assert.deepEqual(problems, [], 'errors are shown on the page, not thrown');
+  await page.close();
+});
+
+test('the state lives in the URL: reload, back/forward, and hostile hashes', async () => {
+  const { page, problems } = await env.page();
+  await type(page, 'mode-0-frequency', 7);
+  await page.locator('#mode-0-frequency').dispatchEvent('change');
+  await settle(page);
+  assert.match(decodeURIComponent(new URL(page.url()).hash), /"frequencyHz":7/);
+  await page.reload();
+  await page.waitForSelector('body[data-ready="true"]');
+  assert.equal(await page.inputValue('#mode-0-frequency'), '7');
+  await page.selectOption('#shaper-0-family', 'zv');
+  await settle(page);
+  assert.equal((await impulseRows(page)).length, 2);
+  await page.goBack();
+  await settle(page);
+  assert.equal(await page.inputValue('#shaper-0-family'), 'zvd');
+  assert.equal((await impulseRows(page)).length, 3);
+  await page.goForward();
+  await settle(page);
+  assert.equal(await page.inputValue('#shaper-0-family'), 'zv');
+
+  const rowsBefore = await impulseRows(page);
+  for (const hash of ['#state=%7Bnot json', '#garbage', '#state=' + encodeURIComponent('{"modes":"x"}'),
+    '#state=' + encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: 1 }], shapers: [{ family: '<img src=x onerror=alert(1)>' }] }))]) {
+    await page.evaluate((h) => { location.hash = h; }, hash);
+    await settle(page);
+    const text = await page.textContent('body');
+    assert.ok(!(await page.$('img[src="x"]')), 'no markup from the hash');
+    if (hash.includes('img')) {
+      assert.match(text, /unknown variant/);
+    } else {
+      assert.match(await page.textContent('#general-error'), /state|link/i, hash);
+      assert.deepEqual(await impulseRows(page), rowsBefore);
+    }
+  }
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('exports hold the designed shaper exactly', async () => {
+  const { page, problems } = await env.page();
+  await page.selectOption('#shaper-0-family', 'zv');
+  await type(page, 'mode-0-frequency', 2);
+  await type(page, 'mode-0-damping', 0);
+  await settle(page);
+  const out = async (format) => {
+    await page.selectOption('#export-format', format);
+    return page.inputValue('#export-output');
+  };
+  assert.equal(await out('csv'), 'time_s,amplitude\n0,0.5\n0.25,0.5\n');
+  assert.equal(await out('json'), '{"impulses":[{"time":0,"amplitude":0.5},{"time":0.25,"amplitude":0.5}],"duration":0.25}');
+  assert.equal(await out('rrf'), 'M593 P"custom" H0.5 T0.25');
+  assert.match(await out('c'), /static const float shaper_amplitude\[SHAPER_COUNT\] = \{ 5\.00000000e-1f, 5\.00000000e-1f \};/);
+  assert.match(await out('c'), /ZV for 2 Hz, ζ 0/);
+  assert.deepEqual(problems, []);
   await page.close();
 });
 
@@ -95,6 +231,8 @@ test('the page works at phone size', async () => {
   const { page, problems } = await env.page({ width: 390, height: 844 });
   const info = await canvasInfo(page, 'sensitivity-chart');
   assert.ok(info.ink > 1000);
+  const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+  assert.ok(overflow <= 1, `no horizontal scrolling of the page: ${overflow}px`);
   await page.screenshot({ path: `${SCREENSHOTS}phone-390x844.png`, fullPage: true });
   assert.deepEqual(problems, []);
   await page.close();

@@ -1,0 +1,119 @@
+// The page's whole state as one JSON object, its presets, and its home in the URL hash.
+//
+// state = {
+//   modes:   [{ frequencyHz, damping }]          1 … 6
+//   shapers: [{ family, …parameters }]            1 … 4
+//   view:    { vtol, scv }
+// }
+
+export const MAX_MODES = 6;
+export const MAX_SHAPERS = 4;
+
+export const DEFAULT_STATE = {
+  modes: [{ frequencyHz: 2, damping: 0.05 }],
+  shapers: [{ family: 'zvd' }],
+  view: { vtol: 0.05, scv: 5 },
+};
+
+/** Presets from the papers (and one printer axis). */
+export const PRESETS = [
+  {
+    id: 'singer-seering',
+    title: 'Singer & Seering 1988: one lightly damped mode (ZV, ZVD, ZVDD)',
+    state: {
+      modes: [{ frequencyHz: 1, damping: 0.05 }],
+      shapers: [{ family: 'zv' }, { family: 'zvd' }, { family: 'zvdd' }],
+      view: { vtol: 0.05, scv: 5 },
+    },
+  },
+  {
+    id: 'veciana',
+    title: 'Veciana & Cardona 2011 test bed: 1.2 Hz and 3.4 Hz',
+    state: {
+      modes: [{ frequencyHz: 1.2, damping: 0.012 }, { frequencyHz: 3.4, damping: 0.013 }],
+      shapers: [{ family: 'zv' }, { family: 'zvd' }],
+      view: { vtol: 0.05, scv: 5 },
+    },
+  },
+  {
+    id: 'printer',
+    title: '3D-printer axis: 45 Hz, ζ = 0.1',
+    state: {
+      modes: [{ frequencyHz: 45, damping: 0.1 }],
+      shapers: [{ family: 'zv' }, { family: 'zvd' }],
+      view: { vtol: 0.05, scv: 5 },
+    },
+  },
+];
+
+const clone = (x) => JSON.parse(JSON.stringify(x));
+
+/**
+ * Checks the *shape* of a state read from outside (URL hash, imported file). Values are not
+ * judged here — the core does that and names the field — but the structure must be what the
+ * page can edit. Returns a fresh state, or throws an Error with a message for a person.
+ */
+export function checkState(value) {
+  const fail = (why) => {
+    throw new Error(`Not a playground state: ${why}.`);
+  };
+  if (!value || typeof value !== 'object' || Array.isArray(value)) fail('expected an object');
+  const { modes, shapers, view } = value;
+  if (!Array.isArray(modes) || modes.length < 1 || modes.length > MAX_MODES) {
+    fail(`"modes" must be a list of 1 to ${MAX_MODES} modes`);
+  }
+  const num = (x) => typeof x === 'number' || x === null;
+  modes.forEach((m, i) => {
+    if (!m || typeof m !== 'object' || !num(m.frequencyHz) || !num(m.damping ?? 0)) {
+      fail(`modes[${i}] must be { frequencyHz: number, damping: number }`);
+    }
+  });
+  if (!Array.isArray(shapers) || shapers.length < 1 || shapers.length > MAX_SHAPERS) {
+    fail(`"shapers" must be a list of 1 to ${MAX_SHAPERS} shapers`);
+  }
+  shapers.forEach((s, i) => {
+    if (!s || typeof s !== 'object' || typeof s.family !== 'string' || s.family.length > 40) {
+      fail(`shapers[${i}] must have a "family" name`);
+    }
+    for (const [k, v] of Object.entries(s)) {
+      const ok = typeof v === 'string' ? v.length <= 200 : num(v) || (Array.isArray(v) && v.length <= 64 && v.every(num))
+        || (v && typeof v === 'object' && !Array.isArray(v) && JSON.stringify(v).length <= 4000);
+      if (!ok) fail(`shapers[${i}].${k} has an unsupported value`);
+    }
+  });
+  if (view !== undefined && (typeof view !== 'object' || view === null || Array.isArray(view))) {
+    fail('"view" must be an object');
+  }
+  const out = clone({ modes, shapers, view: { ...DEFAULT_STATE.view, ...(view ?? {}) } });
+  out.modes = out.modes.map((m) => ({ frequencyHz: m.frequencyHz, damping: m.damping ?? 0 }));
+  return out;
+}
+
+/** The URL hash for a state: `#state=` + URI-encoded JSON (readable, and shareable as is). */
+export function toHash(state) {
+  return `#state=${encodeURIComponent(JSON.stringify(state))}`;
+}
+
+/**
+ * The state in a URL hash. Returns `{ state }`, `{ state: null }` for an empty hash, or
+ * `{ error }` with a message for a garbled or hostile one.
+ */
+export function fromHash(hash) {
+  if (!hash || hash === '#') return { state: null };
+  if (hash.length > 20000) return { error: 'The link is too long to be a playground state.' };
+  const m = /^#state=(.*)$/s.exec(hash);
+  if (!m) return { error: 'The link does not hold a playground state (expected #state=…).' };
+  let parsed;
+  try {
+    parsed = JSON.parse(decodeURIComponent(m[1]));
+  } catch {
+    return { error: 'The link’s state is not valid JSON; the last good state is kept.' };
+  }
+  try {
+    return { state: checkState(parsed) };
+  } catch (e) {
+    return { error: `${e.message} The last good state is kept.` };
+  }
+}
+
+export { clone };
