@@ -1,0 +1,57 @@
+// Page benchmark (not a test): time full updates of the playground in headless Chromium —
+// recompute everything and redraw every chart, as one input event does — with 3 modes and
+// 4 compared shapers, and report p50 / p95 / max in ms, plus the shipped size (gzip).
+// Run: npm run bench:page   (after npm run build)
+import { chromium } from 'playwright-core';
+import { readFileSync, readdirSync } from 'node:fs';
+import { gzipSync } from 'node:zlib';
+import { startServer } from '../scripts/serve.mjs';
+
+const RUNS = Number(process.env.RUNS ?? 200);
+const state = {
+  modes: [
+    { frequencyHz: 1.2, damping: 0.012 },
+    { frequencyHz: 3.4, damping: 0.013 },
+    { frequencyHz: 7.9, damping: 0.02 },
+  ],
+  shapers: [{ family: 'zv' }, { family: 'zvd' }, { family: 'zvdd' }, { family: 'zvdn', derivatives: 3 }],
+  view: { vtol: 0.05, scv: 5 },
+};
+
+const { server, url } = await startServer({ port: 0 });
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+});
+try {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  await page.goto(`${url}#state=${encodeURIComponent(JSON.stringify(state))}`);
+  await page.waitForSelector('body[data-ready="true"]');
+  const times = await page.evaluate(async (runs) => {
+    const out = [];
+    for (let i = 0; i < 10; i++) window.__playground.update(); // warm up
+    for (let i = 0; i < runs; i++) {
+      const input = document.getElementById('mode-0-frequency');
+      input.value = String(1.2 + (i % 10) * 0.01);
+      window.__playground.state.modes[0].frequencyHz = Number(input.value);
+      out.push(window.__playground.update());
+    }
+    return out;
+  }, RUNS);
+  const errors = await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
+  if (errors.length) throw new Error(`page errors during the benchmark: ${errors.join('; ')}`);
+  times.sort((a, b) => a - b);
+  const q = (p) => times[Math.min(times.length - 1, Math.floor(p * times.length))];
+  console.log(`full update, 3 modes, 4 shapers, all charts (${RUNS} runs): p50 ${q(0.5).toFixed(2)} ms, p95 ${q(0.95).toFixed(2)} ms, max ${times[times.length - 1].toFixed(2)} ms (budget: p95 16 ms)`);
+} finally {
+  await browser.close();
+  server.close();
+}
+
+const root = new URL('..', import.meta.url);
+const files = [
+  'pkg/input_shaping_bg.wasm', 'pkg/input_shaping.js', 'index.html',
+  ...readdirSync(new URL('web/', root)).map((f) => `web/${f}`),
+];
+const gz = files.reduce((sum, f) => sum + gzipSync(readFileSync(new URL(f, root)), { level: 9 }).length, 0);
+console.log(`shipped (wasm + JS + HTML + CSS): ${(gz / 1024).toFixed(1)} KiB gzip (budget: 300 KB)`);
