@@ -137,3 +137,63 @@ fn sensitivity_rejects_bad_options() {
         Err(Error::TooLarge { .. })
     ));
 }
+
+/// The grid recurrence is the same V as eq. 11, point by point, over long grids, with damping,
+/// for negative and many-impulse shapers.
+#[wasm_bindgen_test(unsupported = test)]
+fn grid_recurrence_agrees_with_the_formula() {
+    use input_shaping::vibration::{vibration_on_grid, vibration_rad};
+    let mut seed = 12345u64;
+    let mut rand = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for (n_imp, zeta) in [(2, 0.0), (5, 0.05), (40, 0.3), (300, 0.01)] {
+        let s = Shaper::new(
+            (0..n_imp)
+                .map(|_| Impulse {
+                    time: rand() * 3.0,
+                    amplitude: rand() - 0.3,
+                })
+                .collect(),
+        )
+        .unwrap();
+        let mut out = Vec::new();
+        let (from, step, n) = (0.1, 0.0137, 3000);
+        vibration_on_grid(s.impulses(), from, step, n, zeta, &mut out);
+        assert_eq!(out.len(), n);
+        for (k, v) in out.iter().enumerate() {
+            let exact = vibration_rad(s.impulses(), 2.0 * PI * (from + step * k as f64), zeta);
+            assert!(
+                (v - exact).abs()
+                    < 1e-12 * (1.0 + s.impulses().iter().map(|i| i.amplitude.abs()).sum::<f64>()),
+                "k={k}: {v} vs {exact}"
+            );
+        }
+    }
+}
+
+/// Long multi-mode shapers stay cheap: the band trace is bounded in work (MAX_SCAN_WORK) and still
+/// brackets true crossings.
+#[wasm_bindgen_test(unsupported = test)]
+fn insensitivity_of_a_long_shaper_is_bounded_and_correct() {
+    use input_shaping::design::zero_vibration::zv_dn;
+    use input_shaping::vibration::insensitivity;
+    let mut s = Shaper::identity();
+    for f in [1.0, 2.3, 5.1, 11.0] {
+        s = s
+            .convolve(&zv_dn(&Mode::new(f, 0.02).unwrap(), 5).unwrap())
+            .unwrap();
+    }
+    assert_eq!(s.len(), 7usize.pow(4));
+    let mode = Mode::new(1.0, 0.02).unwrap();
+    let band = insensitivity(&s, &mode, 0.05).unwrap();
+    let v = |f: f64| residual_vibration(&s, &Mode::new(f, 0.02).unwrap());
+    close(v(band.low_hz), 0.05, 1e-6, "V at the low edge");
+    assert!(
+        band.high_hz >= 11.0,
+        "the robust bands of the four modes merge: {band:?}"
+    );
+}
