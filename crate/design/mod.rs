@@ -8,6 +8,7 @@
 //! (Singer & Seering 1988 §2.3). Every design is checked against its guarantee with an
 //! independent evaluation of V before it is returned.
 
+pub mod quantize;
 pub mod sampled;
 pub mod zero_vibration;
 
