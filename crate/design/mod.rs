@@ -116,8 +116,9 @@ pub const FAMILIES: &[FamilyInfo] = &[
     FamilyInfo {
         name: "sampled",
         title: "Sampled (t = iT)",
-        guarantee: "V = 0 and dV/dω = 0 at the mode, impulses on the period T, ramp delay m·T if \
-                    asked, amplitude/increment bounds; least control error J_q",
+        guarantee: "V = 0 at the mode with `derivatives` derivatives (default 1), impulses at \
+                    t = iT, ramp delay m·T if asked, amplitude/increment bounds; least control \
+                    error J_q; one mode",
         parameters: &[
             "periodS",
             "impulses",

@@ -541,7 +541,7 @@ impl Problem {
 /// Bounds of eq. 7 may be exceeded by at most this much (rounding of the final solve).
 const BOUND_TOLERANCE: f64 = 1e-9;
 /// Most working-set changes of the active-set loop.
-const MAX_ACTIVE_SET_STEPS: usize = 400;
+const MAX_ACTIVE_SET_STEPS: usize = 60;
 
 fn max_violation(g: &DMatrix<f64>, h: &DVector<f64>, x: &DVector<f64>) -> f64 {
     (g * x - h).iter().fold(0.0_f64, |m, &v| m.max(v))
