@@ -392,6 +392,10 @@ fn spec_parses_and_errors_name_fields() {
         Some("weight")
     );
     assert_eq!(
+        field(r#""periodS":0.01,"impulses":20,"weight":1e7"#).as_deref(),
+        Some("weight")
+    );
+    assert_eq!(
         field(r#""periodS":0.01,"impulses":20,"derivatives":9"#).as_deref(),
         Some("derivatives")
     );
@@ -417,6 +421,25 @@ fn spec_parses_and_errors_name_fields() {
         shaper: ShaperSpec::Sampled(SampledSpec::new(0.01, 20)),
     };
     assert_eq!(design(&two_modes).unwrap_err().field(), Some("modes"));
+    // Full compensation (eq. 11) in six impulses needs amplitudes of ~10⁴ (the paper warns of
+    // "huge amplitude values within short sequences"); V then sits at the rounding limit: the
+    // design either meets V = 0 or is refused with that reason — never a wrong shaper.
+    let huge_mode = Mode::new(3.0, 0.1).unwrap();
+    for objective in [Objective::ControlError, Objective::MinimumNorm] {
+        let spec = SampledSpec {
+            delay_samples: Some(0),
+            objective,
+            ..SampledSpec::new(0.01, 6)
+        };
+        match sampled::design(&huge_mode, &spec) {
+            Ok(d) => {
+                assert!(residual_vibration(&d.shaper, &huge_mode) <= 1e-9);
+                assert!(d.amplitudes.iter().any(|a| a.abs() > 1e3));
+            }
+            Err(Error::Infeasible { reason }) => assert!(reason.contains("Σ|Aᵢ|"), "{reason}"),
+            Err(e) => panic!("expected infeasible, got {e}"),
+        }
+    }
     // A period that puts every impulse at the same phase makes eq. 13 singular: an error.
     let singular = DesignRequest {
         modes: vec![ModeSpec {

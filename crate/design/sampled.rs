@@ -64,11 +64,13 @@ use nalgebra::{Complex, DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 /// Most impulses a sampled shaper may have (the KKT system is dense, O(n³) to solve).
-pub const MAX_IMPULSES: usize = 400;
+pub const MAX_IMPULSES: usize = 256;
 /// Most derivative conditions (rows weighted by tᵢ, …, tᵢᵏ) accepted.
 pub const MAX_DERIVATIVES: u32 = 3;
 /// The paper's weight, Q = 0.1 · I (Kamel et al. Fig. 3).
 pub const DEFAULT_WEIGHT: f64 = 0.1;
+/// Largest weight accepted (beyond it the control error no longer matters numerically).
+pub const MAX_WEIGHT: f64 = 1e6;
 
 /// What the amplitudes minimise.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -271,6 +273,13 @@ impl Problem {
                 "weight",
                 format!("must be ≥ 0, got {weight}"),
             ));
+        }
+        if weight > MAX_WEIGHT {
+            return Err(Error::TooLarge {
+                field: "weight".into(),
+                value: weight,
+                limit: MAX_WEIGHT,
+            });
         }
         let omega = mode.omega_rad_s();
         let gain = match spec.plant_gain {
@@ -520,6 +529,12 @@ impl Problem {
     /// The amplitudes A₀ … A_{n−1} minimising the objective subject to eq. 13 and the bounds.
     pub fn solve(&self) -> Result<Vec<f64>> {
         let (h, f) = self.quadratic();
+        if h.iter().chain(f.iter()).any(|v| !v.is_finite()) {
+            return Err(Error::invalid(
+                "plantGain",
+                "the cost overflows: the plant gain is too large for this mode",
+            ));
+        }
         let (c, b) = self.constraints();
         let x = equality_qp(&h, &f, &c, &b).ok_or_else(|| Error::Infeasible {
             reason: "the constraints of eq. 13 are singular for this mode and period (is the \
@@ -783,8 +798,20 @@ fn check(
             reason: format!("the sampled design failed its own check: {what}"),
         })
     };
-    super::verify(shaper, &[*mode], &super::Guarantee::ZeroAtModes)?;
     let magnitude: f64 = shaper.impulses().iter().map(|i| i.amplitude.abs()).sum();
+    super::verify(shaper, &[*mode], &super::Guarantee::ZeroAtModes).map_err(|e| {
+        if magnitude > 100.0 {
+            Error::Infeasible {
+                reason: format!(
+                    "the constraints need amplitudes with Σ|Aᵢ| = {magnitude:.3e}, too large \
+                     to cancel the vibration in floating point; add impulses, lengthen \
+                     delaySamples or raise weight"
+                ),
+            }
+        } else {
+            e
+        }
+    })?;
     let sum = shaper.amplitude_sum();
     if (sum - 1.0).abs() > 1e-9 * magnitude.max(1.0) {
         return fail(format!("Σ A = {sum}, not 1"));
