@@ -400,3 +400,48 @@ pub fn klipper_figures(shaper: JsValue, options: JsValue) -> Result<JsValue, JsV
         .map_err(|e| js_error(e.within("options")))?;
     to_js(&figures)
 }
+
+/// `rampDelay(shaper, { frequencyHz, damping })` → τ = 2ζ/ω + Σ Aᵢtᵢ / Σ Aᵢ in seconds, the lag
+/// of the plant's response to a slow ramp (Kamel, Lange & Hirzinger eq. 10).
+#[wasm_bindgen(js_name = rampDelay)]
+pub fn ramp_delay(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue> {
+    let shaper = shaper_from_js(shaper).map_err(js_error)?;
+    let mode = mode_from_js(mode, "mode").map_err(js_error)?;
+    design::sampled::ramp_delay(&shaper, &mode).map_err(|e| js_error(e.within("shaper")))
+}
+
+/// `sampledReport(spec)`, `spec.family = "sampled"` → `{ impulses, duration, startTime,
+/// rampDelay, cost: { total, controlError, amplitudePenalty }, baselineCost, costReduction }`:
+/// the design `design(spec)` returns plus its ramp delay (eq. 10) and cost J_q (eq. 17), and the
+/// cost of the minimum-norm shaper under the same constraints.
+#[wasm_bindgen(js_name = sampledReport)]
+pub fn sampled_report(spec: JsValue) -> Result<JsValue, JsValue> {
+    let request: DesignRequest = from_js(spec, "").map_err(js_error)?;
+    let ShaperSpec::Sampled(sampled) = &request.shaper else {
+        return Err(js_error(Error::invalid(
+            "family",
+            format!(
+                "sampledReport needs family \"sampled\", got \"{}\"",
+                request.shaper.name()
+            ),
+        )));
+    };
+    let modes = Mode::list(&request.modes).map_err(js_error)?;
+    let report = design::sampled::report(&modes, sampled).map_err(js_error)?;
+    to_js(&report)
+}
+
+/// `quantize(shaper, { frequencyHz, damping }, { amplitudeSteps, tickS?, method?, rampS?,
+/// vtol? })` → `{ impulses, duration, amplitudeSum, vtol, vibrationBefore, vibrationAfter,
+/// insensitivityBefore, insensitivityAfter }`: the shaper rounded for an integer controller
+/// (Peláez & Singhose 2002) and what rounding cost at the mode.
+#[wasm_bindgen]
+pub fn quantize(shaper: JsValue, mode: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+    let shaper = shaper_from_js(shaper).map_err(js_error)?;
+    let mode = mode_from_js(mode, "mode").map_err(js_error)?;
+    let options: design::quantize::QuantizeOptions =
+        from_js(options, "options").map_err(js_error)?;
+    let report = design::quantize::quantize_with_report(&shaper, &mode, &options)
+        .map_err(|e| js_error(e.within("options")))?;
+    to_js(&report)
+}

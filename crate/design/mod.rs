@@ -8,6 +8,8 @@
 //! (Singer & Seering 1988 §2.3). Every design is checked against its guarantee with an
 //! independent evaluation of V before it is returned.
 
+pub mod quantize;
+pub mod sampled;
 pub mod zero_vibration;
 
 use crate::error::{Error, Result};
@@ -32,6 +34,9 @@ pub enum ShaperSpec {
         /// [`zero_vibration::MAX_DERIVATIVES`].
         derivatives: u32,
     },
+    /// Impulses on the controller period with a prescribed ramp delay and the least control
+    /// error (Kamel, Lange & Hirzinger); parameters in [`sampled::SampledSpec`].
+    Sampled(sampled::SampledSpec),
 }
 
 impl ShaperSpec {
@@ -42,6 +47,7 @@ impl ShaperSpec {
             ShaperSpec::Zvd => "zvd",
             ShaperSpec::Zvdd => "zvdd",
             ShaperSpec::Zvdn { .. } => "zvdn",
+            ShaperSpec::Sampled(_) => "sampled",
         }
     }
 
@@ -107,6 +113,27 @@ pub const FAMILIES: &[FamilyInfo] = &[
         parameters: &["derivatives"],
         source: "Singer & Seering 1988 §2.2 (binomial form)",
     },
+    FamilyInfo {
+        name: "sampled",
+        title: "Sampled (t = iT)",
+        guarantee: "V = 0 at the mode with `derivatives` derivatives (default 1), impulses at \
+                    t = iT, ramp delay m·T if asked, amplitude/increment bounds; least control \
+                    error J_q; one mode",
+        parameters: &[
+            "periodS",
+            "impulses",
+            "delaySamples",
+            "weight",
+            "derivatives",
+            "plantGain",
+            "objective",
+            "amplitudeMin",
+            "amplitudeMax",
+            "incrementMin",
+            "incrementMax",
+        ],
+        source: "Kamel, Lange & Hirzinger, eqs. 4-25",
+    },
 ];
 
 /// What a designed shaper promises, checked by [`verify`] before it is returned.
@@ -163,6 +190,10 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
             } else {
                 per_mode(modes, |m| zero_vibration::zv_dn(m, *derivatives))?
             },
+            Guarantee::ZeroAtModes,
+        ),
+        ShaperSpec::Sampled(spec) => (
+            sampled::design_for_modes(modes, spec)?.shaper,
             Guarantee::ZeroAtModes,
         ),
     };
