@@ -87,14 +87,17 @@ function shaperCard(spec, k) {
   family.addEventListener('change', () => {
     const next = { family: family.value };
     const nextInfo = familyTable.find((f) => f.name === family.value);
-    for (const p of nextInfo?.parameters ?? []) next[p] = spec[p] ?? paramInfo(p).default;
+    for (const p of nextInfo?.parameters ?? []) {
+      const d = paramInfo(p, family.value).default;
+      if (d !== undefined) next[p] = d;
+    }
     state.shapers[k] = next;
     rebuild();
     changed(true);
   });
   const params = (info?.parameters ?? []).map((name) => {
-    const pinfo = paramInfo(name);
-    if (!(name in spec)) spec[name] = pinfo.default;
+    const pinfo = paramInfo(name, spec.family);
+    if (!(name in spec) && pinfo.default !== undefined && !pinfo.optional) spec[name] = pinfo.default;
     let input;
     if (pinfo.kind === 'select') {
       input = el('select', { id: `shaper-${k}-${name}`, dataset: { field: `shapers[${k}].${name}` } },
@@ -108,7 +111,12 @@ function shaperCard(spec, k) {
       if (pinfo.min !== undefined) input.min = String(pinfo.min);
       if (pinfo.max !== undefined) input.max = String(pinfo.max);
     }
-    input.addEventListener('input', () => { spec[name] = parseParam(pinfo, input.value); changed(); });
+    input.addEventListener('input', () => {
+      const v = parseParam(pinfo, input.value);
+      if (v === undefined) delete spec[name];
+      else spec[name] = v;
+      changed();
+    });
     const f = field(pinfo.label, input);
     if (pinfo.help) f.append(el('span', { class: 'hint' }, pinfo.help));
     return f;

@@ -1,19 +1,38 @@
 // How each family parameter is edited on the page. Parameters are named as in a design spec
 // (README, "Shaper families"); a parameter not listed here gets a plain number field.
 // kind: 'number' | 'integer' | 'numbers' (comma-separated list) | 'percent' (fraction shown in %)
-// | 'select'.
+// | 'select' (with `options`). `optional`: a blank field leaves the parameter out of the spec
+// (the core's default applies). FAMILY_PARAMS overrides PARAMS for one family.
 export const PARAMS = {
   derivatives: { label: 'Zero derivatives n', kind: 'integer', min: 0, max: 30, default: 3 },
+  periodS: { label: 'Controller period T (s)', kind: 'number', default: 0.012 },
+  delaySamples: { label: 'Ramp delay m (periods; blank = free, 0 = full compensation)', kind: 'integer', optional: true, default: 17 },
+  weight: { label: 'Control-error weight Q', kind: 'number', default: 0.1 },
+  plantGain: { label: 'Plant gain K (s²; blank = 1/ω²)', kind: 'number', optional: true },
+  objective: { label: 'Objective', kind: 'select', options: ['controlError', 'minimumNorm'], default: 'controlError' },
+  amplitudeMin: { label: 'Amplitude min (blank = none)', kind: 'number', optional: true },
+  amplitudeMax: { label: 'Amplitude max (blank = none)', kind: 'number', optional: true },
+  incrementMin: { label: 'Increment min (blank = none)', kind: 'number', optional: true },
+  incrementMax: { label: 'Increment max (blank = none)', kind: 'number', optional: true },
 };
 
-/** The editing description of parameter `name` (a sensible default for unknown ones). */
-export function paramInfo(name) {
-  return PARAMS[name] ?? { label: name, kind: 'number', default: 0 };
+export const FAMILY_PARAMS = {
+  sampled: {
+    impulses: { label: 'Impulses n', kind: 'integer', min: 2, max: 256, default: 36 },
+    derivatives: { label: 'Zero derivatives', kind: 'integer', min: 0, max: 3, default: 1 },
+  },
+};
+
+/** The editing description of parameter `name` of `family` (a plain number for unknown ones). */
+export function paramInfo(name, family) {
+  return FAMILY_PARAMS[family]?.[name] ?? PARAMS[name] ?? { label: name, kind: 'number', default: 0 };
 }
 
-/** Reads an input's text as the parameter's value (NaN / [] when not a number: the core says why). */
+/** Reads an input's text as the parameter's value: NaN / [] when not a number (the core then
+ * says why), `undefined` for a blank optional parameter. */
 export function parseParam(info, text) {
   const t = String(text).trim();
+  if (info.optional && t === '') return undefined;
   if (info.kind === 'numbers') {
     return t === '' ? [] : t.split(/[,\s;]+/).filter(Boolean).map(Number);
   }

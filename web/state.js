@@ -36,6 +36,19 @@ export const PRESETS = [
     },
   },
   {
+    id: 'kamel',
+    title: 'Kamel, Lange & Hirzinger: robot joint, ω = 30 rad/s, ζ = 0.02, T = 12 ms',
+    state: {
+      modes: [{ frequencyHz: 30 / (2 * Math.PI), damping: 0.02 }],
+      shapers: [
+        { family: 'sampled', periodS: 0.012, impulses: 36, delaySamples: 17, weight: 0.1, derivatives: 1, plantGain: 8e-4, objective: 'controlError' },
+        { family: 'sampled', periodS: 0.012, impulses: 36, delaySamples: 17, weight: 0.1, derivatives: 1, plantGain: 8e-4, objective: 'minimumNorm' },
+        { family: 'zvd' },
+      ],
+      view: { vtol: 0.05, scv: 5 },
+    },
+  },
+  {
     id: 'printer',
     title: '3D-printer axis: 45 Hz, ζ = 0.1',
     state: {
