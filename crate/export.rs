@@ -102,6 +102,68 @@ pub fn to_c_float(shaper: &Shaper, name: &str, comment: &str) -> Result<String> 
     Ok(out)
 }
 
+/// A C header fragment for integer controllers: amplitudes as integer counts of
+/// 1/`amplitude_steps` (`int32_t <name>_amplitude_q[]`, summing exactly to `amplitude_steps` for
+/// a unity-gain shaper) and times as integer counts of `tick_s` (`uint32_t <name>_time_ticks[]`),
+/// rounded by [`crate::design::quantize::quantize`] (largest remainder; impulses landing on the
+/// same tick are merged). Peláez & Singhose 2002 show what such rounding costs in robustness;
+/// `quantize` reports it.
+pub fn to_c_fixed(
+    shaper: &Shaper,
+    name: &str,
+    comment: &str,
+    amplitude_steps: u32,
+    tick_s: f64,
+) -> Result<String> {
+    use crate::design::quantize::{quantize, QuantizeOptions};
+    let name = c_identifier(name)?;
+    let upper = name.to_ascii_uppercase();
+    let rounded = quantize(
+        shaper,
+        &QuantizeOptions {
+            tick_s: Some(tick_s),
+            ..QuantizeOptions::new(amplitude_steps)
+        },
+    )?;
+    let steps = f64::from(amplitude_steps);
+    let q: Vec<String> = rounded
+        .impulses()
+        .iter()
+        .map(|imp| format!("{}", (imp.amplitude * steps).round() as i64))
+        .collect();
+    if rounded.duration() / tick_s > f64::from(u32::MAX) {
+        return Err(Error::invalid(
+            "tickS",
+            format!("{tick_s} s is too fine: the tick counts do not fit in 32 bits"),
+        ));
+    }
+    let ticks: Vec<String> = rounded
+        .impulses()
+        .iter()
+        .map(|imp| format!("{}", (imp.time / tick_s).round() as u64))
+        .collect();
+    let mut out = String::new();
+    let _ = writeln!(out, "/* {} */", c_comment(comment));
+    let _ = writeln!(
+        out,
+        "/* fixed point: amplitude = q / {amplitude_steps}, time = ticks * {tick_s} s; {} impulses */",
+        rounded.len()
+    );
+    let _ = writeln!(out, "#define {upper}_COUNT {}", rounded.len());
+    let _ = writeln!(out, "#define {upper}_AMPLITUDE_SCALE {amplitude_steps}");
+    let _ = writeln!(
+        out,
+        "static const int32_t {name}_amplitude_q[{upper}_COUNT] = {{ {} }};",
+        q.join(", ")
+    );
+    let _ = writeln!(
+        out,
+        "static const uint32_t {name}_time_ticks[{upper}_COUNT] = {{ {} }};",
+        ticks.join(", ")
+    );
+    Ok(out)
+}
+
 /// A number with up to 7 significant digits and no exponent, trailing zeros trimmed (RRF's
 /// G-code parser reads plain decimals).
 fn gcode_number(x: f64) -> String {

@@ -346,14 +346,22 @@ struct ExportOptions {
     /// C identifier prefix for `"c"` (default `shaper`).
     #[serde(default)]
     name: Option<String>,
-    /// First-line comment for `"c"`.
+    /// First-line comment for `"c"` and `"cFixed"`.
     #[serde(default)]
     comment: Option<String>,
+    /// `"cFixed"`: amplitude resolution (e.g. 255 for 8-bit PWM; default 65535).
+    #[serde(default)]
+    amplitude_steps: Option<u32>,
+    /// `"cFixed"`: timer tick in seconds (default 1e-5).
+    #[serde(default)]
+    tick_s: Option<f64>,
 }
 
-/// `exportShaper(shaper, { format, name?, comment? })` → the export as a string: `"csv"`
-/// (`time_s,amplitude` rows), `"json"` (as `design` returns), `"c"` (float arrays
-/// `<name>_time_s`, `<name>_amplitude`), `"rrf"` (RepRapFirmware 3.6+ `M593 P"custom"` line).
+/// `exportShaper(shaper, { format, name?, comment?, amplitudeSteps?, tickS? })` → the export
+/// as a string: `"csv"` (`time_s,amplitude` rows), `"json"` (as `design` returns), `"c"`
+/// (float arrays `<name>_time_s`, `<name>_amplitude`), `"cFixed"` (integer amplitudes in
+/// 1/`amplitudeSteps` and times in ticks of `tickS`), `"rrf"` (RepRapFirmware 3.6+
+/// `M593 P"custom"` line).
 #[wasm_bindgen(js_name = exportShaper)]
 pub fn export_shaper(shaper: JsValue, options: JsValue) -> Result<String, JsValue> {
     use crate::export;
@@ -368,10 +376,18 @@ pub fn export_shaper(shaper: JsValue, options: JsValue) -> Result<String, JsValu
             options.comment.as_deref().unwrap_or("input shaper"),
         )
         .map_err(|e| js_error(e.within("options"))),
+        "cFixed" => export::to_c_fixed(
+            &shaper,
+            options.name.as_deref().unwrap_or("shaper"),
+            options.comment.as_deref().unwrap_or("input shaper"),
+            options.amplitude_steps.unwrap_or(65535),
+            options.tick_s.unwrap_or(1e-5),
+        )
+        .map_err(|e| js_error(e.within("options"))),
         "rrf" => export::to_rrf_m593(&shaper).map_err(|e| js_error(e.within("shaper"))),
         other => Err(js_error(Error::invalid(
             "options.format",
-            format!("unknown export format {other:?}; expected csv, json, c or rrf"),
+            format!("unknown export format {other:?}; expected csv, json, c, cFixed or rrf"),
         ))),
     }
 }

@@ -135,3 +135,43 @@ fn rrf_rejects_what_it_cannot_represent() {
         .to_string()
         .contains("summing to 1"));
 }
+
+/// Fixed point: ZVD for 40 Hz, ζ = 0.1 at 8-bit resolution and a 10 µs tick. The integer
+/// amplitudes sum exactly to 255 and each is within one step of A·255; ticks are round(t/tick).
+#[wasm_bindgen_test(unsupported = test)]
+fn c_fixed_point_rounds_exactly() {
+    use input_shaping::export::to_c_fixed;
+    let s = zvd(&Mode::new(40.0, 0.1).unwrap()).unwrap();
+    let c = to_c_fixed(&s, "zvd_x", "ZVD 40 Hz", 255, 1e-5).unwrap();
+    let array = |key: &str| -> Vec<i64> {
+        let line = c.lines().find(|l| l.contains(key)).unwrap();
+        line.split('{')
+            .nth(1)
+            .unwrap()
+            .split('}')
+            .next()
+            .unwrap()
+            .split(',')
+            .map(|x| x.trim().parse().unwrap())
+            .collect()
+    };
+    let q = array("_amplitude_q");
+    let ticks = array("_time_ticks");
+    assert_eq!(q.iter().sum::<i64>(), 255);
+    for (k, imp) in s.impulses().iter().enumerate() {
+        assert!(
+            (q[k] as f64 - imp.amplitude * 255.0).abs() < 1.0,
+            "amplitude {k}"
+        );
+        assert_eq!(ticks[k], (imp.time / 1e-5).round() as i64, "tick {k}");
+    }
+    assert!(c.contains("#define ZVD_X_AMPLITUDE_SCALE 255"));
+    assert_eq!(
+        to_c_fixed(&s, "x", "", 0, 1e-5).unwrap_err().field(),
+        Some("amplitudeSteps")
+    );
+    assert_eq!(
+        to_c_fixed(&s, "x", "", 255, -1.0).unwrap_err().field(),
+        Some("tickS")
+    );
+}

@@ -213,11 +213,15 @@ function showExport() {
   const r = lastGood.result.results[k];
   if (!r) return;
   const m = lastGood.state.modes.map((mode) => `${mode.frequencyHz} Hz, ζ ${mode.damping}`).join('; ');
+  const format = $('export-format').value;
+  $('fixed-options').hidden = format !== 'cFixed';
   try {
     $('export-output').value = exportShaper(r.shaper, {
-      format: $('export-format').value,
+      format,
       name: 'shaper',
       comment: `input-shaping: ${r.label} for ${m}`,
+      amplitudeSteps: readNumber($('export-steps')),
+      tickS: readNumber($('export-tick')),
     });
   } catch (e) {
     $('export-output').value = '';
@@ -319,9 +323,11 @@ async function main() {
   $('controls').addEventListener('submit', (e) => e.preventDefault());
   $('export-shaper').addEventListener('change', showExport);
   $('export-format').addEventListener('change', showExport);
+  $('export-steps').addEventListener('input', showExport);
+  $('export-tick').addEventListener('input', showExport);
   $('export-copy').addEventListener('click', () => navigator.clipboard?.writeText($('export-output').value).then(() => notice('Export copied.'), () => notice('Copy failed: select the text and copy it.')));
   $('export-download').addEventListener('click', () => {
-    const ext = { csv: 'csv', json: 'json', c: 'h', rrf: 'g' }[$('export-format').value];
+    const ext = { csv: 'csv', json: 'json', c: 'h', cFixed: 'h', rrf: 'g' }[$('export-format').value];
     download(`shaper.${ext}`, $('export-output').value);
   });
   $('copy-link').addEventListener('click', () => navigator.clipboard?.writeText(location.href).then(() => notice('Link copied.'), () => notice('Copy failed: copy the address bar.')));

@@ -223,6 +223,15 @@ test('exports hold the designed shaper exactly', async () => {
   assert.equal(await out('rrf'), 'M593 P"custom" H0.5 T0.25');
   assert.match(await out('c'), /static const float shaper_amplitude\[SHAPER_COUNT\] = \{ 5\.00000000e-1f, 5\.00000000e-1f \};/);
   assert.match(await out('c'), /ZV for 2 Hz, ζ 0/);
+  // 8-bit amplitudes and a 1 ms tick: [128, 127] (largest remainder keeps the sum 255) at [0, 250].
+  await page.selectOption('#export-format', 'cFixed');
+  await page.fill('#export-steps', '255');
+  await page.fill('#export-tick', '0.001');
+  const fixed = await page.inputValue('#export-output');
+  assert.match(fixed, /shaper_amplitude_q\[SHAPER_COUNT\] = \{ 128, 127 \}|shaper_amplitude_q\[SHAPER_COUNT\] = \{ 127, 128 \}/);
+  assert.match(fixed, /shaper_time_ticks\[SHAPER_COUNT\] = \{ 0, 250 \}/);
+  await page.fill('#export-steps', '0');
+  assert.match(await page.textContent('#export-error'), /amplitudeSteps/);
   assert.deepEqual(problems, []);
   await page.close();
 });
