@@ -431,7 +431,9 @@ pub const MAX_STREAMING_DELAY: usize = 10_000_000;
 /// An input shaper run the way a controller runs it: one sample in, one sample out, at a fixed
 /// sample period T. Impulse i (amplitude Aᵢ, time tᵢ) becomes two taps: weight Aᵢ(1 − φᵢ) at
 /// delay nᵢ and Aᵢφᵢ at nᵢ + 1, where tᵢ/T = nᵢ + φᵢ — linear interpolation of the input at
-/// the fractional delay. Taps at the same delay are merged.
+/// the fractional delay. Taps at the same delay are merged. Before the first sample the input is
+/// taken as 0, so a signal whose first sample is not 0 is read as rising linearly from 0 over
+/// the sample period before t = 0 (start a signal at rest to avoid this).
 #[derive(Debug, Clone)]
 pub struct StreamingShaper {
     delays: Vec<usize>,
