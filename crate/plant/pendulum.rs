@@ -19,7 +19,9 @@ use crate::mode::Mode;
 use serde::{Deserialize, Serialize};
 
 /// Most Runge–Kutta steps one simulation may take.
-pub const MAX_STEPS: usize = 5_000_000;
+pub const MAX_STEPS: usize = 2_000_000;
+/// Shortest cable accepted during hoisting, as a fraction of the initial length.
+pub const MIN_LENGTH_FRACTION: f64 = 0.01;
 /// Relative tolerance of the integrator.
 const RTOL: f64 = 1e-10;
 /// Absolute tolerance of the integrator (radians, radians per second).
@@ -142,6 +144,29 @@ impl Pendulum {
         }
         let empty = Piecewise::new(Vec::new())?;
         let hoist = self.hoist.as_ref().unwrap_or(&empty);
+        // The cable must stay long enough over the whole window (checked before integrating,
+        // densely on every polynomial piece of the hoist).
+        let t_end = samples.saturating_sub(1) as f64 * sample_period;
+        let mut checks: Vec<f64> = (0..=256).map(|i| t_end * i as f64 / 256.0).collect();
+        let hk = hoist.knots();
+        for (i, k) in hk.iter().enumerate() {
+            let next = hk.get(i + 1).map_or(t_end.max(k.time), |n| n.time);
+            checks.extend((0..=16).map(|j| k.time + (next - k.time) * j as f64 / 16.0));
+        }
+        for t in checks.into_iter().filter(|t| *t <= t_end) {
+            let len = self.length + hoist.eval(t)[0];
+            if len.is_nan() || len < MIN_LENGTH_FRACTION * self.length {
+                return Err(Error::invalid(
+                    "hoist",
+                    format!(
+                        "the cable length reaches {len} m at t = {t} s; it must stay above {} m \
+                         ({} % of length)",
+                        MIN_LENGTH_FRACTION * self.length,
+                        MIN_LENGTH_FRACTION * 100.0
+                    ),
+                ));
+            }
+        }
         let mut trolley = Cursor::new(command);
         let mut cable = Cursor::new(hoist);
         let w0 = (self.gravity / self.length).sqrt();
@@ -161,7 +186,6 @@ impl Pendulum {
             steps: 0,
         };
         let tk = command.knots();
-        let hk = hoist.knots();
         for k in 0..samples {
             let target = k as f64 * sample_period;
             loop {
