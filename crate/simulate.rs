@@ -199,17 +199,32 @@ pub struct SimulationResult {
 
 /// The shaper a spec asks for (if any), validated and designed.
 pub fn spec_shaper(spec: &SimulationSpec, plant: &Plant) -> Result<Option<Shaper>> {
-    match (&spec.shaper, &spec.impulses) {
+    resolve_shaper(&spec.shaper, &spec.impulses, || plant.modes())
+}
+
+/// A shaper from a `shaper` design request or explicit `impulses` (at most one of them);
+/// `default_modes` supplies the modes when the request leaves them out.
+pub fn resolve_shaper(
+    shaper: &Option<ShaperRequest>,
+    impulses: &Option<Vec<Impulse>>,
+    default_modes: impl FnOnce() -> Result<Vec<Mode>>,
+) -> Result<Option<Shaper>> {
+    match (shaper, impulses) {
         (Some(_), Some(_)) => Err(Error::invalid(
             "impulses",
             "give either shaper (a design) or impulses (an explicit shaper), not both",
         )),
         (None, None) => Ok(None),
-        (None, Some(imp)) => Ok(Some(Shaper::new(imp.clone())?)),
+        (None, Some(imp)) => Ok(Some(Shaper::new(imp.clone()).map_err(|e| match e {
+            Error::InvalidInput { field, reason } if field.starts_with("impulses") => {
+                Error::InvalidInput { field, reason }
+            }
+            other => other.within("impulses"),
+        })?)),
         (Some(req), None) => {
             let modes = match &req.modes {
                 Some(m) => Mode::list(m).map_err(|e| e.within("shaper"))?,
-                None => plant.modes()?,
+                None => default_modes()?,
             };
             design_for(&req.shaper, &modes)
                 .map(Some)
