@@ -532,33 +532,38 @@ impl StreamingShaper {
 
     /// Filters a block: `output[k]` = what [`push`](Self::push) would return for `input[k]`.
     /// Processes `min(input.len(), output.len())` samples; the state carries over to the next
-    /// call.
+    /// call. Works in cache-sized chunks: the history and a chunk of input are laid out in one
+    /// linear buffer, then each tap is one vectorisable pass over the chunk.
     pub fn process(&mut self, input: &[f64], output: &mut [f64]) {
+        const CHUNK: usize = 2048;
         let n = input.len().min(output.len());
         let (input, output) = (&input[..n], &mut output[..n]);
-        if n <= 4 * (self.max_delay + 1) {
+        let m = self.max_delay;
+        if n <= 2 * (m + 1) || n < 64 {
             for (x, y) in input.iter().zip(output.iter_mut()) {
                 *y = self.push(*x);
             }
             return;
         }
-        // Long block: history (the last max_delay inputs) followed by the block, then one
-        // vectorisable pass per tap.
-        let m = self.max_delay;
-        let mut ext = Vec::with_capacity(m + n);
-        for i in (0..m).rev() {
-            ext.push(self.buffer[self.pos.wrapping_sub(i) & self.mask]);
+        // scratch = [x[k−m] … x[k−1] | chunk]: the history, oldest first, then the chunk.
+        let mut scratch = vec![0.0; m + CHUNK.min(n)];
+        for i in 0..m {
+            scratch[m - 1 - i] = self.buffer[self.pos.wrapping_sub(i) & self.mask];
         }
-        ext.extend_from_slice(input);
-        output.iter_mut().for_each(|y| *y = 0.0);
-        for (&d, &w) in self.delays.iter().zip(&self.weights) {
-            let src = &ext[m - d..m - d + n];
-            for (y, x) in output.iter_mut().zip(src) {
-                *y += w * x;
+        for (xin, yout) in input.chunks(CHUNK).zip(output.chunks_mut(CHUNK)) {
+            let len = xin.len();
+            scratch[m..m + len].copy_from_slice(xin);
+            yout.iter_mut().for_each(|y| *y = 0.0);
+            for (&d, &w) in self.delays.iter().zip(&self.weights) {
+                let src = &scratch[m - d..m - d + len];
+                for (y, x) in yout.iter_mut().zip(src) {
+                    *y += w * x;
+                }
             }
+            scratch.copy_within(len..len + m, 0);
         }
-        // Keep the last max_delay + 1 inputs as the new history.
-        for &x in &ext[ext.len() - (m + 1).min(ext.len())..] {
+        // Back into the ring: the last m inputs (oldest first), ending at pos.
+        for &x in &scratch[..m] {
             self.pos = (self.pos + 1) & self.mask;
             self.buffer[self.pos] = x;
         }

@@ -24,7 +24,8 @@ use std::f64::consts::PI;
 
 /// Most frequencies in one spectrum.
 pub const MAX_SPECTRUM_POINTS: usize = 100_000;
-/// Most (samples × frequencies) products for sampled signals.
+/// Most (samples × frequencies) products for sampled signals (and 16 × knots × frequencies
+/// for piecewise ones).
 pub const MAX_SAMPLED_WORK: f64 = 2e8;
 
 /// Which signal's spectrum: the command (position), its velocity or its acceleration.
@@ -157,6 +158,14 @@ fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
 /// Spectrum of a piecewise-polynomial command's position, velocity or acceleration.
 pub fn piecewise_spectrum(p: &Piecewise, options: &SpectrumOptions) -> Result<Spectrum> {
     let f = grid(options)?;
+    let work = 16.0 * p.knots().len() as f64 * f.len() as f64;
+    if work > MAX_SAMPLED_WORK {
+        return Err(Error::TooLarge {
+            field: "points".into(),
+            value: work,
+            limit: MAX_SAMPLED_WORK,
+        });
+    }
     let r = options.signal.order();
     let span = p.end_time() - p.start_time();
     let final_state = p.final_state();

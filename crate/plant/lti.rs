@@ -175,26 +175,39 @@ impl Lti {
         let mut states = keep_states.then(|| Vec::with_capacity(n * samples));
         let mut cursor = Cursor::new(command);
         let knots = command.knots();
-        // Knots before t = 0 are applied by propagating from their own time to 0: handled by
-        // the same mechanism with a virtual previous sample at −∞ (they all are ≤ 0, so their
-        // δ = 0 − τ ≥ 0).
-        let mut t_prev = f64::NEG_INFINITY;
+        // Outputs as sparse rows: (state index, coefficient) and (derivative, coefficient).
+        let sparse: Vec<(Vec<(usize, f64)>, Vec<(usize, f64)>)> = (0..OUTPUTS)
+            .map(|row| {
+                (
+                    (0..n)
+                        .filter(|&j| self.c[(row, j)] != 0.0)
+                        .map(|j| (j, self.c[(row, j)]))
+                        .collect(),
+                    (0..q)
+                        .filter(|&kk| self.d[(row, kk)] != 0.0)
+                        .map(|kk| (kk, self.d[(row, kk)]))
+                        .collect(),
+                )
+            })
+            .collect();
         let mut w_prev = [0.0; ORDER];
         for k in 0..samples {
             let t = k as f64 * sample_period;
             // Advance x from t_prev to t.
             if k > 0 {
-                for (b, &(start, m)) in self.blocks.iter().enumerate() {
-                    let bm = &maps[b];
-                    for i in 0..m {
+                for (bm, &(start, m)) in maps.iter().zip(&self.blocks) {
+                    let xb = &x[start..start + m];
+                    for (i, xo) in xn[start..start + m].iter_mut().enumerate() {
+                        let phi = &bm.phi[i * m..(i + 1) * m];
+                        let gam = &bm.gamma[i * q..(i + 1) * q];
                         let mut s = 0.0;
-                        for j in 0..m {
-                            s += bm.phi[i * m + j] * x[start + j];
+                        for (p, xv) in phi.iter().zip(xb) {
+                            s += p * xv;
                         }
-                        for (kk, wv) in w_prev.iter().take(q).enumerate() {
-                            s += bm.gamma[i * q + kk] * wv;
+                        for (g, wv) in gam.iter().zip(&w_prev[..q]) {
+                            s += g * wv;
                         }
-                        xn[start + i] = s;
+                        *xo = s;
                     }
                 }
                 std::mem::swap(&mut x, &mut xn);
@@ -211,9 +224,6 @@ impl Lti {
                         *xi += v;
                     }
                 } else {
-                    if t_prev == f64::NEG_INFINITY && delta.is_infinite() {
-                        return Err(Error::invalid("command", "knot time is not finite"));
-                    }
                     let key = delta.to_bits();
                     if !cache.contains_key(&key) {
                         if cache.len() > 4096 {
@@ -245,20 +255,19 @@ impl Lti {
                 cursor.pass_next();
             }
             let w = cursor.state_at(t);
-            for (row, out) in outputs.iter_mut().enumerate() {
+            for (out, (cs, ds)) in outputs.iter_mut().zip(&sparse) {
                 let mut y = 0.0;
-                for (j, xj) in x.iter().enumerate() {
-                    y += self.c[(row, j)] * xj;
+                for &(j, c) in cs {
+                    y += c * x[j];
                 }
-                for (kk, wv) in w.iter().take(q).enumerate() {
-                    y += self.d[(row, kk)] * wv;
+                for &(kk, d) in ds {
+                    y += d * w[kk];
                 }
                 out.push(y);
             }
             if let Some(s) = states.as_mut() {
                 s.extend_from_slice(&x);
             }
-            t_prev = t;
             w_prev = w;
         }
         Ok(LtiResponse { outputs, states })
