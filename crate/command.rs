@@ -225,16 +225,17 @@ impl Piecewise {
 /// polynomial of that degree: uₖ(t + h) = Σ_{m ≥ k} uₘ(t) hᵐ⁻ᵏ/(m − k)!.
 pub(crate) fn taylor_shift(state: &[f64; ORDER], deg: usize, h: f64) -> [f64; ORDER] {
     let mut out = [0.0; ORDER];
-    for k in 0..=deg.min(MAX_DEGREE) {
+    let deg = deg.min(MAX_DEGREE);
+    for (k, o) in out.iter_mut().enumerate().take(deg + 1) {
         let mut sum = 0.0;
         let mut pw = 1.0; // h^{m-k}/(m-k)!
-        for (i, m) in (k..=deg.min(MAX_DEGREE)).enumerate() {
+        for (i, s) in state[k..=deg].iter().enumerate() {
             if i > 0 {
                 pw *= h / i as f64;
             }
-            sum += state[m] * pw;
+            sum += s * pw;
         }
-        out[k] = sum;
+        *o = sum;
     }
     out
 }

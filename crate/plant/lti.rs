@@ -56,6 +56,9 @@ struct BlockMaps {
     gamma: Vec<f64>, // m × q, row-major
 }
 
+/// One output row as (state index, coefficient) and (command derivative, coefficient) pairs.
+type SparseRow = (Vec<(usize, f64)>, Vec<(usize, f64)>);
+
 /// Samples of the six outputs and the final state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LtiResponse {
@@ -176,7 +179,7 @@ impl Lti {
         let mut cursor = Cursor::new(command);
         let knots = command.knots();
         // Outputs as sparse rows: (state index, coefficient) and (derivative, coefficient).
-        let sparse: Vec<(Vec<(usize, f64)>, Vec<(usize, f64)>)> = (0..OUTPUTS)
+        let sparse: Vec<SparseRow> = (0..OUTPUTS)
             .map(|row| {
                 (
                     (0..n)
