@@ -519,7 +519,7 @@ impl StreamingShaper {
         self.pos = 0;
     }
 
-    /// One sample in, one out: y[k] = Σ wⱼ x[k − dⱼ].
+    /// One sample in, one out: `y[k] = Σ wⱼ x[k − dⱼ]`.
     #[inline]
     pub fn push(&mut self, x: f64) -> f64 {
         self.pos = (self.pos + 1) & self.mask;
