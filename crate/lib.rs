@@ -20,17 +20,28 @@
 //! - [`design`]: the spec, the table of families, and one file per family of the literature.
 //! - [`smoothing`]: Klipper-compatible smoothing and suggested maximum acceleration.
 //! - [`export`]: CSV, JSON, C arrays and RepRapFirmware `M593` lines.
+//! - [`command`]: reference commands (step, ramp, trapezoid, S-curve, sampled) and shaping
+//!   them (exact convolution, streaming filter).
+//! - [`profile`]: pulse-convolution profiles and their B-spline form (Veciana & Cardona 2011).
+//! - [`plant`]: modal LTI, two-mass spring, nonlinear pendulum; [`simulate`]: their responses;
+//!   [`metrics`]: residual vibration, settling, delay, peaks; [`spectrum`]: |U(f)|.
 //! - [`chart`]: charts drawn with plotters on any backend (canvas in the page, SVG in tests).
 //! - [`error`]: the one error type; nothing reachable from the public API panics.
 //! - `wasm` (wasm32 only): the JavaScript API (`design`, `residualVibration`, `sensitivity`, …).
 
 pub mod chart;
+pub mod command;
 pub mod design;
 pub mod error;
 pub mod export;
+pub mod metrics;
 pub mod mode;
+pub mod plant;
+pub mod profile;
 pub mod shaper;
+pub mod simulate;
 pub mod smoothing;
+pub mod spectrum;
 pub mod vibration;
 
 #[cfg(target_arch = "wasm32")]

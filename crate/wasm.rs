@@ -461,3 +461,24 @@ pub fn quantize(shaper: JsValue, mode: JsValue, options: JsValue) -> Result<JsVa
         .map_err(|e| js_error(e.within("options")))?;
     to_js(&report)
 }
+
+/// `simulate(spec)`: `spec = { plant, command, shaper? | impulses?, duration?, samplePeriod? |
+/// sampleRateHz? }` → `{ time, unshaped: { basePosition, baseVelocity, baseAcceleration,
+/// endpoint, endpointVelocity, endpointAcceleration, deflection, swingAngle?, metrics },
+/// shaped (same, or null), shaper, modesHz, samplePeriod }`. See the README for every field.
+#[wasm_bindgen]
+pub fn simulate(spec: JsValue) -> Result<JsValue, JsValue> {
+    let spec: crate::simulate::SimulationSpec = from_js(spec, "").map_err(js_error)?;
+    let result = crate::simulate::run(&spec).map_err(js_error)?;
+    to_js(&result)
+}
+
+/// `spectrum(spec)`: `spec = { command, shaper? | impulses?, plant?, fromHz?, toHz?, points?,
+/// signal? }` → `{ frequencyHz, magnitude, unshaped, modesHz }` (|U(f)| of the shaped and the
+/// unshaped command's velocity by default).
+#[wasm_bindgen]
+pub fn spectrum(spec: JsValue) -> Result<JsValue, JsValue> {
+    let spec: crate::spectrum::SpectrumSpec = from_js(spec, "").map_err(js_error)?;
+    let result = crate::spectrum::spectrum_for(&spec).map_err(js_error)?;
+    to_js(&result)
+}

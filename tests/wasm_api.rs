@@ -139,3 +139,61 @@ fn exports_and_klipper_figures() {
     // so Klipper's find_shaper_max_accel returns 0 (its `_bisect` starts with func(1e-9)).
     assert_eq!(get(&figures, "maxAccel").as_f64(), Some(0.0));
 }
+
+#[wasm_bindgen_test]
+fn simulate_returns_both_responses_in_one_call() {
+    let r = wasm::simulate(js(r#"{
+        "plant": {"kind":"modal","modes":[{"frequencyHz":1.1,"damping":0}]},
+        "command": {"kind":"step","distance":2},
+        "shaper": {"family":"zv","modes":[{"frequencyHz":1,"damping":0}]},
+        "duration": 4, "sampleRateHz": 500 }"#))
+    .unwrap();
+    let time: js_sys::Array = get(&r, "time").dyn_into().unwrap();
+    assert_eq!(time.length(), 2001);
+    let shaped = get(&r, "shaped");
+    let endpoint: js_sys::Array = get(&shaped, "endpoint").dyn_into().unwrap();
+    assert_eq!(endpoint.length(), 2001);
+    let metrics = get(&shaped, "metrics");
+    let prv: js_sys::Array = get(&metrics, "modeResidualPercent").dyn_into().unwrap();
+    // V of ZV(1 Hz) at 1.1 Hz, undamped: |cos(π·1.1/2)| = 0.1564…
+    let v = (std::f64::consts::PI * 1.1 / 2.0).cos().abs();
+    assert!((prv.get(0).as_f64().unwrap() - 100.0 * v).abs() < 1e-9);
+    assert!(get(&get(&r, "unshaped"), "deflection").is_array());
+    // Undamped and 15.6 % residual: it never settles within 2 % (null), but it has a residual.
+    assert!(get(&metrics, "settlingTime2").is_null());
+    assert!(get(&metrics, "residualVibrationPercent").as_f64().unwrap() > 15.0);
+    let (message, field) = error_message(
+        wasm::simulate(js(
+            r#"{"plant":{"kind":"modal","modes":[{"frequencyHz":1}]},
+            "command":{"kind":"step"},"samplePeriod":-1}"#,
+        ))
+        .unwrap_err(),
+    );
+    assert_eq!(field.as_deref(), Some("samplePeriod"), "{message}");
+    let (message, _) = error_message(
+        wasm::simulate(js(
+            r#"{"plant":{"kind":"modal","modes":[{"frequencyHz":1}]},
+            "command":{"kind":"step"},"duration":1e9,"samplePeriod":1}"#,
+        ))
+        .unwrap_err(),
+    );
+    assert!(message.contains("at most 500000"), "{message}");
+}
+
+#[wasm_bindgen_test]
+fn spectrum_of_a_shaped_step_is_zero_at_the_mode() {
+    let r = wasm::spectrum(js(r#"{
+        "command": {"kind":"step"},
+        "shaper": {"family":"zv","modes":[{"frequencyHz":2,"damping":0}]},
+        "fromHz": 0, "toHz": 4, "points": 5 }"#))
+    .unwrap();
+    let m: js_sys::Array = get(&r, "magnitude").dyn_into().unwrap();
+    let u: js_sys::Array = get(&r, "unshaped").dyn_into().unwrap();
+    assert!(m.get(2).as_f64().unwrap() < 1e-12, "zero at 2 Hz");
+    assert!(
+        (u.get(2).as_f64().unwrap() - 1.0).abs() < 1e-12,
+        "a step's velocity is δ"
+    );
+    let modes: js_sys::Array = get(&r, "modesHz").dyn_into().unwrap();
+    assert_eq!(modes.get(0).as_f64(), Some(2.0));
+}

@@ -1,0 +1,283 @@
+//! What the papers judge a shaped move by: residual vibration after the move, settling and
+//! rise time, ramp delay, deflection during the move, peak acceleration and jerk, and the
+//! acceleration peak-valley count (fatigue; Veciana & Cardona 2011 §3.1).
+//!
+//! Signal-based metrics read the simulated [`Trajectory`], so they work for every plant,
+//! including the nonlinear pendulum; command-based ones (peaks, peak-valley count) read the
+//! command exactly where it is piecewise polynomial.
+
+use crate::command::{Command, Cursor, Piecewise};
+use crate::error::Result;
+use crate::plant::modal::ModalPlant;
+use crate::simulate::Trajectory;
+use serde::Serialize;
+
+/// Points per polynomial piece at which command-based metrics sample the command.
+const PER_PIECE: usize = 64;
+
+/// Metrics of one simulated move. Times in seconds from t = 0; percentages of the move's
+/// distance. `None` (JSON `null`) when a metric does not apply (e.g. no settling for a ramp).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Metrics {
+    /// When the applied command stops changing (its last knot).
+    pub move_end: f64,
+    /// Distance of the reference move (final minus initial base position), if it ends at rest.
+    pub distance: Option<f64>,
+    /// Largest |endpoint − final position| after `moveEnd`, in % of |distance| (the vibration
+    /// error of Singer & Seering 1988 §2.2.1, measured on the response).
+    pub residual_vibration_percent: Option<f64>,
+    /// Largest |endpoint − final position| after `moveEnd` (length units).
+    pub residual_amplitude: Option<f64>,
+    /// Residual vibration amplitude of each mode at `moveEnd`, in % of what an unshaped step
+    /// of the same distance leaves (modal plants only). For a shaped step this is exactly
+    /// 100·V(ω, ζ) (Singhose 2009 eq. 11).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mode_residual_percent: Option<Vec<f64>>,
+    /// Time after which the endpoint stays within 2 % of the distance around the final
+    /// position (within the simulated window).
+    pub settling_time2: Option<f64>,
+    /// Same with a 5 % band.
+    pub settling_time5: Option<f64>,
+    /// Time for the endpoint to go from 10 % to 90 % of the distance (first crossings).
+    pub rise_time: Option<f64>,
+    /// Ramp delay τ: how far the endpoint lags the reference ramp at the end of the window,
+    /// (r − y)/r' (Kamel et al. eq. 10 predicts τ = 2ζ/ω + Σ Aᵢtᵢ). Only for commands that end
+    /// moving.
+    pub delay: Option<f64>,
+    /// Largest |deflection| while the command moves (t ≤ `moveEnd`).
+    pub peak_deflection: f64,
+    /// Largest |base acceleration| of the command (`null` if the velocity jumps: unbounded).
+    pub peak_acceleration: Option<f64>,
+    /// Largest |jerk| of the command (`null` if the acceleration jumps: unbounded).
+    pub peak_jerk: Option<f64>,
+    /// Number of peaks and valleys (turning points) of the command's acceleration — the
+    /// fatigue count of Veciana & Cardona 2011 §3.1.
+    pub acceleration_peak_valley_count: usize,
+}
+
+/// Computes the metrics of `trajectory`, the response to `applied` (the command actually sent,
+/// shaped or not); distances, settling and delay refer to `reference` (the unshaped command).
+pub fn metrics(trajectory: &Trajectory, applied: &Command, reference: &Command) -> Result<Metrics> {
+    let t = &trajectory.time;
+    let y = &trajectory.endpoint;
+    let move_end = applied.end_time();
+    let ref_pw = reference.to_piecewise()?;
+    let at_rest = ref_pw.ends_at_rest();
+    let final_pos = ref_pw.final_state()[0];
+    let distance = at_rest.then_some(final_pos);
+    let d = final_pos.abs();
+    let usable = at_rest && d > 0.0;
+
+    let residual_amplitude = if at_rest {
+        t.iter()
+            .zip(y)
+            .filter(|(ti, _)| **ti >= move_end)
+            .map(|(_, yi)| (yi - final_pos).abs())
+            .reduce(f64::max)
+    } else {
+        None
+    };
+    let residual_vibration_percent = residual_amplitude.filter(|_| usable).map(|a| 100.0 * a / d);
+    let settling = |band: f64| -> Option<f64> {
+        if !usable {
+            return None;
+        }
+        let last_out = y.iter().rposition(|yi| (yi - final_pos).abs() > band * d);
+        match last_out {
+            None => Some(0.0),
+            Some(i) if i + 1 < t.len() => Some(t[i + 1]),
+            Some(_) => None,
+        }
+    };
+    let crossing = |level: f64| -> Option<f64> {
+        let target = level * final_pos;
+        for i in 1..y.len() {
+            let (a, b) = (y[i - 1] - target, y[i] - target);
+            if (a < 0.0) != (b < 0.0) || b == 0.0 {
+                let f = if a == b { 1.0 } else { a / (a - b) };
+                return Some(t[i - 1] + f * (t[i] - t[i - 1]));
+            }
+        }
+        None
+    };
+    let rise_time = if usable {
+        match (crossing(0.1), crossing(0.9)) {
+            (Some(a), Some(b)) => Some(b - a),
+            _ => None,
+        }
+    } else {
+        None
+    };
+    let delay = match (t.last(), y.last()) {
+        (Some(&te), Some(&ye)) if !at_rest => {
+            let r = ref_pw.eval(te);
+            (r[1] != 0.0).then(|| (r[0] - ye) / r[1])
+        }
+        _ => None,
+    };
+    let peak_deflection = t
+        .iter()
+        .zip(&trajectory.deflection)
+        .filter(|(ti, _)| **ti <= move_end)
+        .map(|(_, d)| d.abs())
+        .fold(0.0, f64::max);
+    let (peak_acceleration, peak_jerk, count) = match applied {
+        Command::Piecewise(p) => command_peaks(p),
+        Command::Sampled(s) => sampled_peaks(s.values(), s.period()),
+    };
+    Ok(Metrics {
+        move_end,
+        distance,
+        residual_vibration_percent,
+        residual_amplitude,
+        mode_residual_percent: None,
+        settling_time2: settling(0.02),
+        settling_time5: settling(0.05),
+        rise_time,
+        delay,
+        peak_deflection,
+        peak_acceleration,
+        peak_jerk,
+        acceleration_peak_valley_count: count,
+    })
+}
+
+/// Residual vibration of each mode of `plant` when `command` ends (its last knot), in % of
+/// the residual an unshaped step of the same distance leaves (D/√(1−ζ²) in the amplitude
+/// measure √(e² + ((e' + ζωe)/ω_d)²), e = y − final). Computed exactly: the plant is sampled
+/// at t = 0 and at the move's end. `None` if the command does not end at rest or covers no
+/// distance.
+pub fn mode_residual_percent(plant: &ModalPlant, command: &Piecewise) -> Result<Option<Vec<f64>>> {
+    if !command.ends_at_rest() {
+        return Ok(None);
+    }
+    let d = command.final_state()[0];
+    if d == 0.0 {
+        return Ok(None);
+    }
+    let end = command.end_time();
+    let sys = plant.to_lti();
+    let (period, samples) = if end > 0.0 { (end, 2) } else { (1.0, 1) };
+    let r = sys.respond(command, period, samples, true)?;
+    let states = r.states.unwrap_or_default();
+    let n = sys.states();
+    let last = &states[states.len().saturating_sub(n)..];
+    Ok(Some(
+        plant
+            .modes()
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let (w, z, wd) = (m.omega_rad_s(), m.damping(), m.damped_omega_rad_s());
+                let e = last.get(2 * i).copied().unwrap_or(0.0) - d;
+                let de = last.get(2 * i + 1).copied().unwrap_or(0.0);
+                let amp = (e * e + ((de + z * w * e) / wd).powi(2)).sqrt();
+                100.0 * amp * (1.0 - z * z).sqrt() / d.abs()
+            })
+            .collect(),
+    ))
+}
+
+/// Values of the `order`-th derivative of a piecewise command: 0 before it starts, each piece
+/// at [`PER_PIECE`] + 1 points, and its final value.
+fn sample_derivative(p: &Piecewise, order: usize) -> Vec<f64> {
+    let knots = p.knots();
+    let mut out = Vec::with_capacity(knots.len() * (PER_PIECE + 1) + 2);
+    out.push(0.0);
+    let mut cursor = Cursor::new(p);
+    for (i, k) in knots.iter().enumerate() {
+        cursor.seek(k.time);
+        match knots.get(i + 1) {
+            Some(next) => {
+                for j in 0..=PER_PIECE {
+                    let t = k.time + (next.time - k.time) * j as f64 / PER_PIECE as f64;
+                    out.push(cursor.state_at(t)[order]);
+                }
+            }
+            None => out.push(cursor.state_at(k.time)[order]),
+        }
+    }
+    out
+}
+
+/// Peak acceleration, peak jerk (None where unbounded) and acceleration peak-valley count of a
+/// piecewise command.
+fn command_peaks(p: &Piecewise) -> (Option<f64>, Option<f64>, usize) {
+    let jumps_below = |order: usize| {
+        p.knots()
+            .iter()
+            .any(|k| k.jumps.iter().take(order).any(|&j| j != 0.0))
+    };
+    let acc = sample_derivative(p, 2);
+    let max_abs = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let peak_acc = (!jumps_below(2)).then(|| max_abs(&acc));
+    let peak_jerk = (!jumps_below(3)).then(|| max_abs(&sample_derivative(p, 3)));
+    (peak_acc, peak_jerk, peak_valley_count(&acc))
+}
+
+/// Peaks from finite differences of a sampled command.
+fn sampled_peaks(x: &[f64], period: f64) -> (Option<f64>, Option<f64>, usize) {
+    let mut padded = Vec::with_capacity(x.len() + 4);
+    padded.push(0.0);
+    padded.extend_from_slice(x);
+    let last = x.last().copied().unwrap_or(0.0);
+    padded.extend([last, last]);
+    let acc: Vec<f64> = padded
+        .windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]) / (period * period))
+        .collect();
+    let jerk: Vec<f64> = acc.windows(2).map(|w| (w[1] - w[0]) / period).collect();
+    let max_abs = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    (
+        Some(max_abs(&acc)),
+        Some(max_abs(&jerk)),
+        peak_valley_count(&acc),
+    )
+}
+
+/// Number of turning points (peaks and valleys) of a sequence, ignoring changes smaller than
+/// 10⁻⁹ of its largest magnitude (so plateaus and rounding count once or not at all). The first
+/// and last values are not turning points.
+pub fn peak_valley_count(x: &[f64]) -> usize {
+    let scale = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    if scale == 0.0 {
+        return 0;
+    }
+    let h = 1e-9 * scale;
+    let mut count = 0;
+    let mut direction = 0i8; // +1 rising, −1 falling, 0 unknown
+    let mut extreme = x[0];
+    for &v in &x[1..] {
+        match direction {
+            0 => {
+                if v > extreme + h {
+                    direction = 1;
+                    extreme = v;
+                } else if v < extreme - h {
+                    direction = -1;
+                    extreme = v;
+                }
+            }
+            1 => {
+                if v > extreme {
+                    extreme = v;
+                } else if v < extreme - h {
+                    count += 1;
+                    direction = -1;
+                    extreme = v;
+                }
+            }
+            _ => {
+                if v < extreme {
+                    extreme = v;
+                } else if v > extreme + h {
+                    count += 1;
+                    direction = 1;
+                    extreme = v;
+                }
+            }
+        }
+    }
+    count
+}

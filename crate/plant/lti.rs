@@ -1,0 +1,278 @@
+//! Linear time-invariant plants driven by a piecewise-polynomial command, simulated exactly.
+//!
+//! The plant is x' = A x + E w(t), where w = (u, u', u'', …) is the command and its
+//! derivatives. Between knots the command is a polynomial, so w' = S w (S shifts each
+//! derivative down one row) and the augmented state z = (x, w) obeys z' = M z with
+//! M = [[A, E], [0, S]]: over a step h the exact update is z(t + h) = e^{Mh} z(t) (the matrix
+//! exponential, computed by nalgebra's Padé scaling-and-squaring). A knot adds its jumps to w at
+//! its own time τ, so its contribution at the next sample t is e^{M(t − τ)} (impulse, jumps).
+//! Hence the response is exact (to rounding) at any sample rate, for any command built from
+//! polynomial pieces; the states are split into independent diagonal blocks (one per mode) so
+//! the matrices stay small.
+//!
+//! Outputs are rows y = C x + D w: base position/velocity/acceleration and endpoint
+//! position/velocity/acceleration.
+
+use crate::command::{Cursor, Piecewise, ORDER};
+use crate::error::{Error, Result};
+use nalgebra::DMatrix;
+use std::collections::HashMap;
+
+/// Number of output rows of an [`Lti`] plant.
+pub const OUTPUTS: usize = 6;
+/// Output row: base position.
+pub const BASE_POSITION: usize = 0;
+/// Output row: base velocity.
+pub const BASE_VELOCITY: usize = 1;
+/// Output row: base acceleration.
+pub const BASE_ACCELERATION: usize = 2;
+/// Output row: endpoint position.
+pub const ENDPOINT: usize = 3;
+/// Output row: endpoint velocity.
+pub const ENDPOINT_VELOCITY: usize = 4;
+/// Output row: endpoint acceleration.
+pub const ENDPOINT_ACCELERATION: usize = 5;
+
+/// A linear plant x' = A x + E w with outputs C x + D w (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lti {
+    /// State matrix, n × n.
+    pub a: DMatrix<f64>,
+    /// Input matrix, n × [`ORDER`]: column k multiplies the command's k-th derivative.
+    pub e: DMatrix<f64>,
+    /// Output matrix, [`OUTPUTS`] × n.
+    pub c: DMatrix<f64>,
+    /// Feedthrough, [`OUTPUTS`] × [`ORDER`].
+    pub d: DMatrix<f64>,
+    /// Independent diagonal blocks of A as (first state, number of states); E may couple
+    /// each block only to w.
+    pub blocks: Vec<(usize, usize)>,
+}
+
+/// The exact one-step maps of one block for a step h: x ← Φ x + Γ w.
+#[derive(Debug, Clone)]
+struct BlockMaps {
+    phi: Vec<f64>,   // m × m, row-major
+    gamma: Vec<f64>, // m × q, row-major
+}
+
+/// One output row as (state index, coefficient) and (command derivative, coefficient) pairs.
+type SparseRow = (Vec<(usize, f64)>, Vec<(usize, f64)>);
+
+/// Samples of the six outputs and the final state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LtiResponse {
+    /// Output rows (see the row constants), each one value per sample.
+    pub outputs: [Vec<f64>; OUTPUTS],
+    /// The state at each sample, n values per sample (row-major), if requested.
+    pub states: Option<Vec<f64>>,
+}
+
+impl Lti {
+    /// Number of states.
+    pub fn states(&self) -> usize {
+        self.a.nrows()
+    }
+
+    fn block_maps(&self, (start, m): (usize, usize), q: usize, h: f64) -> Result<BlockMaps> {
+        let size = m + q;
+        let mut big = DMatrix::<f64>::zeros(size, size);
+        for i in 0..m {
+            for j in 0..m {
+                big[(i, j)] = self.a[(start + i, start + j)] * h;
+            }
+            for k in 0..q {
+                big[(i, m + k)] = self.e[(start + i, k)] * h;
+            }
+        }
+        for k in 0..q.saturating_sub(1) {
+            big[(m + k, m + k + 1)] = h;
+        }
+        if big.iter().any(|v| !v.is_finite()) {
+            return Err(Error::invalid(
+                "plant",
+                "the plant's matrices are not finite at this sample period",
+            ));
+        }
+        let ex = big.exp();
+        if ex.iter().any(|v| !v.is_finite()) {
+            return Err(Error::invalid(
+                "samplePeriod",
+                "the plant's response overflows over one sample period (unstable plant?)",
+            ));
+        }
+        let mut phi = vec![0.0; m * m];
+        let mut gamma = vec![0.0; m * q];
+        for i in 0..m {
+            for j in 0..m {
+                phi[i * m + j] = ex[(i, j)];
+            }
+            for k in 0..q {
+                gamma[i * q + k] = ex[(i, m + k)];
+            }
+        }
+        Ok(BlockMaps { phi, gamma })
+    }
+
+    /// The state jump a knot causes: a jump Jⱼ in the command's j-th derivative is a Dirac
+    /// Jⱼδ in derivative j + 1, which E turns into the state jump E[:, j+1]·Jⱼ. A Dirac's
+    /// derivative (E reading derivative ≥ j + 2 of a jump in j) is rejected.
+    fn impulse(&self, jumps: &[f64; ORDER], time: f64) -> Result<Vec<f64>> {
+        let n = self.states();
+        let mut imp = vec![0.0; n];
+        for (j, &jump) in jumps.iter().enumerate() {
+            if jump == 0.0 {
+                continue;
+            }
+            for k in j + 1..ORDER {
+                let col = self.e.column(k);
+                if col.iter().all(|&v| v == 0.0) {
+                    continue;
+                }
+                if k > j + 1 {
+                    let what = ["position", "velocity", "acceleration", "jerk"]
+                        .get(j)
+                        .copied()
+                        .unwrap_or("a derivative");
+                    return Err(Error::invalid(
+                        "command",
+                        format!(
+                            "the command's {what} jumps at t = {time} s, which this plant (driven \
+                             by a higher derivative of the command, e.g. force = mass × \
+                             acceleration) cannot follow with a finite input; use a smoother \
+                             command (ramp, trapezoid, S-curve or profile)"
+                        ),
+                    ));
+                }
+                for (s, v) in imp.iter_mut().zip(col.iter()) {
+                    *s += v * jump;
+                }
+            }
+        }
+        Ok(imp)
+    }
+
+    /// Exact response to `command` at t = k·`sample_period`, k = 0 … `samples` − 1. The plant
+    /// starts at rest (x = 0) before the command's first knot.
+    pub fn respond(
+        &self,
+        command: &Piecewise,
+        sample_period: f64,
+        samples: usize,
+        keep_states: bool,
+    ) -> Result<LtiResponse> {
+        let n = self.states();
+        let q = command.degree() + 1;
+        let maps: Vec<BlockMaps> = self
+            .blocks
+            .iter()
+            .map(|&b| self.block_maps(b, q, sample_period))
+            .collect::<Result<_>>()?;
+        let mut cache: HashMap<u64, Vec<BlockMaps>> = HashMap::new();
+        let mut x = vec![0.0; n];
+        let mut xn = vec![0.0; n];
+        let mut outputs: [Vec<f64>; OUTPUTS] = Default::default();
+        for o in outputs.iter_mut() {
+            o.reserve_exact(samples);
+        }
+        let mut states = keep_states.then(|| Vec::with_capacity(n * samples));
+        let mut cursor = Cursor::new(command);
+        let knots = command.knots();
+        // Outputs as sparse rows: (state index, coefficient) and (derivative, coefficient).
+        let sparse: Vec<SparseRow> = (0..OUTPUTS)
+            .map(|row| {
+                (
+                    (0..n)
+                        .filter(|&j| self.c[(row, j)] != 0.0)
+                        .map(|j| (j, self.c[(row, j)]))
+                        .collect(),
+                    (0..q)
+                        .filter(|&kk| self.d[(row, kk)] != 0.0)
+                        .map(|kk| (kk, self.d[(row, kk)]))
+                        .collect(),
+                )
+            })
+            .collect();
+        let mut w_prev = [0.0; ORDER];
+        for k in 0..samples {
+            let t = k as f64 * sample_period;
+            // Advance x from t_prev to t.
+            if k > 0 {
+                for (bm, &(start, m)) in maps.iter().zip(&self.blocks) {
+                    let xb = &x[start..start + m];
+                    for (i, xo) in xn[start..start + m].iter_mut().enumerate() {
+                        let phi = &bm.phi[i * m..(i + 1) * m];
+                        let gam = &bm.gamma[i * q..(i + 1) * q];
+                        let mut s = 0.0;
+                        for (p, xv) in phi.iter().zip(xb) {
+                            s += p * xv;
+                        }
+                        for (g, wv) in gam.iter().zip(&w_prev[..q]) {
+                            s += g * wv;
+                        }
+                        *xo = s;
+                    }
+                }
+                std::mem::swap(&mut x, &mut xn);
+            }
+            // Knots in (t_prev, t].
+            while let Some(knot) = knots.get(cursor.next_index()) {
+                if knot.time > t {
+                    break;
+                }
+                let delta = t - knot.time;
+                let imp = self.impulse(&knot.jumps, knot.time)?;
+                if delta == 0.0 {
+                    for (xi, v) in x.iter_mut().zip(&imp) {
+                        *xi += v;
+                    }
+                } else {
+                    let key = delta.to_bits();
+                    if !cache.contains_key(&key) {
+                        if cache.len() > 4096 {
+                            cache.clear();
+                        }
+                        let m: Vec<BlockMaps> = self
+                            .blocks
+                            .iter()
+                            .map(|&b| self.block_maps(b, q, delta))
+                            .collect::<Result<_>>()?;
+                        cache.insert(key, m);
+                    }
+                    if let Some(dm) = cache.get(&key) {
+                        for (b, &(start, m)) in self.blocks.iter().enumerate() {
+                            let bm = &dm[b];
+                            for i in 0..m {
+                                let mut s = 0.0;
+                                for j in 0..m {
+                                    s += bm.phi[i * m + j] * imp[start + j];
+                                }
+                                for kk in 0..q {
+                                    s += bm.gamma[i * q + kk] * knot.jumps[kk];
+                                }
+                                x[start + i] += s;
+                            }
+                        }
+                    }
+                }
+                cursor.pass_next();
+            }
+            let w = cursor.state_at(t);
+            for (out, (cs, ds)) in outputs.iter_mut().zip(&sparse) {
+                let mut y = 0.0;
+                for &(j, c) in cs {
+                    y += c * x[j];
+                }
+                for &(kk, d) in ds {
+                    y += d * w[kk];
+                }
+                out.push(y);
+            }
+            if let Some(s) = states.as_mut() {
+                s.extend_from_slice(&x);
+            }
+            w_prev = w;
+        }
+        Ok(LtiResponse { outputs, states })
+    }
+}
