@@ -10,6 +10,9 @@
 
 pub mod zero_vibration;
 
+pub(crate) mod equations;
+pub mod extra_insensitive;
+
 use crate::error::{Error, Result};
 use crate::mode::{Mode, ModeSpec};
 use crate::shaper::Shaper;
@@ -32,6 +35,38 @@ pub enum ShaperSpec {
         /// [`zero_vibration::MAX_DERIVATIVES`].
         derivatives: u32,
     },
+    /// Extra-insensitive: V = `vtol` with zero slope at the mode (a hump), zeros either side;
+    /// 3 impulses, about 1 period (Singhose 2009 §3.1, Fig. 7), solved exactly with damping.
+    Ei {
+        /// Height of the hump, fraction (default 0.05 = 5 %), 0.001 … 0.5.
+        #[serde(default = "default_vtol")]
+        vtol: f64,
+    },
+    /// Two-hump EI: humps of height `vtol` either side of the mode, V = 0 at the mode;
+    /// 4 impulses, about 1½ periods.
+    Ei2 {
+        /// Height of the humps, fraction (default 0.05).
+        #[serde(default = "default_vtol")]
+        vtol: f64,
+    },
+    /// Three-hump EI: the middle hump at the mode; 5 impulses, about 2 periods.
+    Ei3 {
+        /// Height of the humps, fraction (default 0.05).
+        #[serde(default = "default_vtol")]
+        vtol: f64,
+    },
+    /// n-hump EI: `humps` humps of height `vtol`, n + 2 impulses, about (n+1)/2 periods.
+    Eihump {
+        /// Number of humps n, 1 … [`extra_insensitive::MAX_HUMPS`] (1 = EI).
+        humps: u32,
+        /// Height of the humps, fraction (default 0.05).
+        #[serde(default = "default_vtol")]
+        vtol: f64,
+    },
+}
+
+fn default_vtol() -> f64 {
+    extra_insensitive::DEFAULT_VTOL
 }
 
 impl ShaperSpec {
@@ -42,6 +77,10 @@ impl ShaperSpec {
             ShaperSpec::Zvd => "zvd",
             ShaperSpec::Zvdd => "zvdd",
             ShaperSpec::Zvdn { .. } => "zvdn",
+            ShaperSpec::Ei { .. } => "ei",
+            ShaperSpec::Ei2 { .. } => "ei2",
+            ShaperSpec::Ei3 { .. } => "ei3",
+            ShaperSpec::Eihump { .. } => "eihump",
         }
     }
 
@@ -107,12 +146,44 @@ pub const FAMILIES: &[FamilyInfo] = &[
         parameters: &["derivatives"],
         source: "Singer & Seering 1988 §2.2 (binomial form)",
     },
+    FamilyInfo {
+        name: "ei",
+        title: "EI",
+        guarantee: "V = vtol with zero slope at each mode, V = 0 either side; exact with damping",
+        parameters: &["vtol"],
+        source: "Singhose 2009 §3.1, Fig. 7; solved by Newton from the ζ = 0 closed form",
+    },
+    FamilyInfo {
+        name: "ei2",
+        title: "Two-hump EI",
+        guarantee: "two humps V = vtol around each mode, V = 0 at the mode and beyond the humps",
+        parameters: &["vtol"],
+        source: "Singhose 2009 §3.1, Fig. 11; Singhose et al. 1997 (multi-hump)",
+    },
+    FamilyInfo {
+        name: "ei3",
+        title: "Three-hump EI",
+        guarantee: "three humps V = vtol (the middle one at each mode), four zeros",
+        parameters: &["vtol"],
+        source: "Singhose 2009 §3.1, Fig. 11; Singhose et al. 1997 (multi-hump)",
+    },
+    FamilyInfo {
+        name: "eihump",
+        title: "n-hump EI",
+        guarantee: "n humps V = vtol with zero slope, n + 1 zeros around them",
+        parameters: &["humps", "vtol"],
+        source: "Singhose 2009 §3.1; Chebyshev closed form at ζ = 0, Newton with damping",
+    },
 ];
 
 /// What a designed shaper promises, checked by [`verify`] before it is returned.
 #[derive(Debug, Clone, PartialEq)]
 #[allow(dead_code)] // AtMost and Valid are for the solved and custom families being added
 pub(crate) enum Guarantee {
+    /// V = 0 (to rounding) at every listed (frequency in Hz, damping ratio) point.
+    ZeroAt(Vec<(f64, f64)>),
+    /// Every one of these.
+    All(Vec<Guarantee>),
     /// V = 0 at every mode (to rounding).
     ZeroAtModes,
     /// V ≤ `vtol` (to `tolerance`) at every listed (frequency in Hz, damping ratio) point.
@@ -165,6 +236,10 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
             },
             Guarantee::ZeroAtModes,
         ),
+        ShaperSpec::Ei { vtol } => extra_insensitive::for_modes(modes, 1, *vtol)?,
+        ShaperSpec::Ei2 { vtol } => extra_insensitive::for_modes(modes, 2, *vtol)?,
+        ShaperSpec::Ei3 { vtol } => extra_insensitive::for_modes(modes, 3, *vtol)?,
+        ShaperSpec::Eihump { humps, vtol } => extra_insensitive::for_modes(modes, *humps, *vtol)?,
     };
     verify(&shaper, modes, &guarantee)?;
     Ok(shaper)
@@ -185,6 +260,28 @@ fn per_mode(modes: &[Mode], single: impl Fn(&Mode) -> Result<Shaper>) -> Result<
 pub(crate) fn verify(shaper: &Shaper, modes: &[Mode], guarantee: &Guarantee) -> Result<()> {
     match guarantee {
         Guarantee::Valid => {}
+        Guarantee::All(all) => {
+            for g in all {
+                verify(shaper, modes, g)?;
+            }
+        }
+        Guarantee::ZeroAt(points) => {
+            for &(f, z) in points {
+                let v = crate::vibration::vibration_rad(
+                    shaper.impulses(),
+                    2.0 * std::f64::consts::PI * f,
+                    z,
+                );
+                if v.is_nan() || v > ZERO_VIBRATION_TOLERANCE {
+                    return Err(Error::Infeasible {
+                        reason: format!(
+                            "the designed shaper leaves V = {v:.3e} at {f} Hz, ζ = {z}, where it \
+                             should vanish"
+                        ),
+                    });
+                }
+            }
+        }
         Guarantee::AtMost {
             vtol,
             points,
