@@ -12,6 +12,7 @@ pub mod zero_vibration;
 
 pub(crate) mod equations;
 pub mod extra_insensitive;
+pub mod modified;
 
 use crate::error::{Error, Result};
 use crate::mode::{Mode, ModeSpec};
@@ -63,6 +64,9 @@ pub enum ShaperSpec {
         #[serde(default = "default_vtol")]
         vtol: f64,
     },
+    /// Klipper's modified ZV: 3 impulses over 0.75 damped period, V = 0 at the mode and near
+    /// 5/3 of it (Klipper shaper_defs.py).
+    Mzv,
 }
 
 fn default_vtol() -> f64 {
@@ -81,6 +85,7 @@ impl ShaperSpec {
             ShaperSpec::Ei2 { .. } => "ei2",
             ShaperSpec::Ei3 { .. } => "ei3",
             ShaperSpec::Eihump { .. } => "eihump",
+            ShaperSpec::Mzv => "mzv",
         }
     }
 
@@ -174,6 +179,13 @@ pub const FAMILIES: &[FamilyInfo] = &[
         parameters: &["humps", "vtol"],
         source: "Singhose 2009 §3.1; Chebyshev closed form at ζ = 0, Newton with damping",
     },
+    FamilyInfo {
+        name: "mzv",
+        title: "MZV (Klipper)",
+        guarantee: "V = 0 at each mode; second zero near 5/3 of it; 0.75 damped period",
+        parameters: &[],
+        source: "Klipper klippy/extras/shaper_defs.py get_mzv_shaper",
+    },
 ];
 
 /// What a designed shaper promises, checked by [`verify`] before it is returned.
@@ -240,6 +252,7 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
         ShaperSpec::Ei2 { vtol } => extra_insensitive::for_modes(modes, 2, *vtol)?,
         ShaperSpec::Ei3 { vtol } => extra_insensitive::for_modes(modes, 3, *vtol)?,
         ShaperSpec::Eihump { humps, vtol } => extra_insensitive::for_modes(modes, *humps, *vtol)?,
+        ShaperSpec::Mzv => (per_mode(modes, modified::mzv)?, Guarantee::ZeroAtModes),
     };
     verify(&shaper, modes, &guarantee)?;
     Ok(shaper)
