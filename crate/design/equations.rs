@@ -37,18 +37,22 @@ impl Param {
 
 /// One equation (one or two rows of the system) on the impulses in `range`.
 #[derive(Debug, Clone, PartialEq)]
-#[allow(dead_code)] // Moment and ZeroSlope: used by the negative shapers, added next
 pub(crate) enum Equation {
     /// Σ Aᵢ = value (one row).
     AmplitudeSum(f64),
-    /// Σ Aᵢ (t_L − tᵢ)^k / k! = value (one row): for a rigid body driven by acceleration
-    /// steps Aᵢ at tᵢ, k = 1 is the final velocity and k = 2 the final position.
+    /// Σ Aᵢ (t_L − tᵢ)^k / k! = value (one row, divided by `scale`): for a rigid body driven
+    /// by acceleration steps Aᵢ at tᵢ, k = 1 is the final velocity and k = 2 the final
+    /// position.
     Moment {
         /// k ≥ 1.
         order: u32,
         /// Required value.
         value: f64,
+        /// Typical size of the terms, so the row is of order one.
+        scale: f64,
     },
+    /// t_L − t_F = value: the time from the first to the last impulse of the range (one row).
+    Span(f64),
     /// P(ω) = 0: V = 0 (two rows, real and imaginary parts).
     Zero(Param),
     /// ∂P/∂ω = 0 at ω where P = 0 too: dV/dω = 0 in the ZVD sense (two rows).
@@ -65,7 +69,7 @@ pub(crate) enum Equation {
 impl Equation {
     fn rows(&self) -> usize {
         match self {
-            Equation::AmplitudeSum(_) | Equation::Moment { .. } => 1,
+            Equation::AmplitudeSum(_) | Equation::Moment { .. } | Equation::Span(_) => 1,
             _ => 2,
         }
     }
@@ -125,7 +129,21 @@ impl System {
                         }
                     }
                 }
-                Equation::Moment { order, value } => {
+                Equation::Span(value) => {
+                    let last = imps.len() - 1;
+                    f[row] = imps[last].time - imps[0].time - value;
+                    if let Some(c) = t_col(last) {
+                        j[(row, c)] += 1.0;
+                    }
+                    if let Some(c) = t_col(0) {
+                        j[(row, c)] -= 1.0;
+                    }
+                }
+                Equation::Moment {
+                    order,
+                    value,
+                    scale,
+                } => {
                     let k_fact: f64 = (1..=*order).map(f64::from).product();
                     let last = imps.len() - 1;
                     let t_l = imps[last].time;
@@ -151,6 +169,10 @@ impl System {
                         j[(row, c)] += d_last;
                     }
                     f[row] = sum - value;
+                    f[row] /= scale;
+                    for c in 0..self.unknowns {
+                        j[(row, c)] /= scale;
+                    }
                 }
                 Equation::Zero(freq) | Equation::ZeroSlope(freq) => {
                     let w = freq.value(x);
@@ -261,43 +283,63 @@ pub(crate) fn newton(system: &System, x0: &DVector<f64>) -> Option<DVector<f64>>
     (f.amax() <= RESIDUAL_TOLERANCE).then_some(x)
 }
 
-/// Largest damping step of the continuation, and the smallest before giving up.
-const MAX_STEP: f64 = 0.05;
-const MIN_STEP: f64 = 1e-4;
+/// Largest damping step of the continuation in ζ.
+const MAX_DAMPING_STEP: f64 = 0.05;
+/// Smallest step, as a fraction of the whole parameter range, before giving up.
+const MIN_STEP_FRACTION: f64 = 1e-4;
 /// Most Newton solves one continuation may take.
 const MAX_SOLVES: usize = 400;
 
-/// Follows the solution of `system_at(ζ)` from `x0` (a solution at ζ = 0) to ζ = `zeta`,
-/// in steps that grow while Newton converges quickly and shrink when it fails, predicting
-/// each step by extrapolating the last two solutions. `valid` rejects solutions that left the
-/// family (impulses out of order, a zero running away). Returns the solution at `zeta`, or
-/// the largest ζ reached on failure.
+/// Follows the solution of `system_at(ζ)` from `x0` (a solution at ζ = 0) to ζ = `zeta`
+/// (see [`continuation`]). Returns the solution at `zeta`, or the largest ζ reached.
 pub(crate) fn continue_in_damping(
     zeta: f64,
     x0: DVector<f64>,
     system_at: impl Fn(f64) -> System,
     valid: impl Fn(&DVector<f64>) -> bool,
 ) -> std::result::Result<DVector<f64>, f64> {
-    let mut x = newton(&system_at(0.0), &x0).filter(&valid).ok_or(0.0)?;
-    let mut z = 0.0;
+    continuation(0.0, zeta, MAX_DAMPING_STEP, x0, system_at, valid)
+}
+
+/// Follows the solution of `system_at(s)` from `x0` (a solution, or a close guess, at
+/// s = `from`) to s = `to`, in steps of at most `max_step` that grow while Newton converges
+/// and shrink when it fails, predicting each step by extrapolating the last two solutions.
+/// `valid` rejects solutions that left the family (impulses out of order, a zero running
+/// away). Returns the solution at `to`, or the parameter reached on failure.
+pub(crate) fn continuation(
+    from: f64,
+    to: f64,
+    max_step: f64,
+    x0: DVector<f64>,
+    system_at: impl Fn(f64) -> System,
+    valid: impl Fn(&DVector<f64>) -> bool,
+) -> std::result::Result<DVector<f64>, f64> {
+    let mut x = newton(&system_at(from), &x0).filter(&valid).ok_or(from)?;
+    let span = to - from;
+    let mut s = from;
     let mut previous: Option<(f64, DVector<f64>)> = None;
-    let mut h = MAX_STEP.min(zeta);
+    let mut h = max_step.min(span.abs());
+    let min_step = MIN_STEP_FRACTION * span.abs();
     let mut solves = 0;
-    while z < zeta {
-        if solves >= MAX_SOLVES || h < MIN_STEP {
-            return Err(z);
+    while (to - s) * span.signum() > 0.0 {
+        if solves >= MAX_SOLVES || h < min_step {
+            return Err(s);
         }
         solves += 1;
-        let z_next = if zeta - z <= h * 1.0001 { zeta } else { z + h };
+        let s_next = if (to - s).abs() <= h * 1.0001 {
+            to
+        } else {
+            s + h * span.signum()
+        };
         let guess = match &previous {
-            Some((zp, xp)) if z > *zp => &x + (&x - xp) * ((z_next - z) / (z - zp)),
+            Some((sp, xp)) if s != *sp => &x + (&x - xp) * ((s_next - s) / (s - sp)),
             _ => x.clone(),
         };
-        match newton(&system_at(z_next), &guess).filter(&valid) {
+        match newton(&system_at(s_next), &guess).filter(&valid) {
             Some(x_next) => {
-                previous = Some((z, std::mem::replace(&mut x, x_next)));
-                z = z_next;
-                h = (h * 1.5).min(MAX_STEP);
+                previous = Some((s, std::mem::replace(&mut x, x_next)));
+                s = s_next;
+                h = (h * 1.5).min(max_step);
             }
             None => h *= 0.5,
         }
@@ -349,13 +391,16 @@ mod tests {
                     Equation::Moment {
                         order: 2,
                         value: 0.3,
+                        scale: 2.0,
                     },
                     0..4,
                 ),
+                (Equation::Span(2.0), 1..3),
                 (
                     Equation::Moment {
                         order: 1,
                         value: 0.1,
+                        scale: 1.0,
                     },
                     1..4,
                 ),
@@ -373,7 +418,7 @@ mod tests {
         };
         let x = DVector::from_vec(vec![0.3, 0.5, 0.6, 1.1, 2.3, 3.4, 0.8, 1.3]);
         let (f, j) = system.evaluate(&x);
-        assert_eq!(f.len(), 9);
+        assert_eq!(f.len(), 10);
         for c in 0..8 {
             let h = 1e-6;
             let mut xp = x.clone();

@@ -285,7 +285,7 @@ pub fn extra_insensitive(mode: &Mode, humps: u32, vtol: f64) -> Result<ExtraInse
         humps_hz: hp.iter().map(|p| p.value(&x) * f).collect(),
         zeros_hz: zp.iter().map(|p| p.value(&x) * f).collect(),
     };
-    verify(&design, mode, vtol)?;
+    verify_extra_insensitive(&design, mode, vtol)?;
     Ok(design)
 }
 
@@ -293,7 +293,11 @@ pub fn extra_insensitive(mode: &Mode, humps: u32, vtol: f64) -> Result<ExtraInse
 const TOLERANCE: f64 = 1e-9;
 
 /// Checks the EI promise with [`vibration_rad`], independently of the equations solved.
-fn verify(design: &ExtraInsensitive, mode: &Mode, vtol: f64) -> Result<()> {
+pub(crate) fn verify_extra_insensitive(
+    design: &ExtraInsensitive,
+    mode: &Mode,
+    vtol: f64,
+) -> Result<()> {
     let zeta = mode.damping();
     let v = |f: f64| vibration_rad(design.shaper.impulses(), 2.0 * PI * f, zeta);
     let fail = |what: String| {
