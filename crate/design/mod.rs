@@ -10,6 +10,7 @@
 
 pub mod zero_vibration;
 
+pub mod custom;
 pub(crate) mod equations;
 pub mod extra_insensitive;
 pub mod modified;
@@ -100,6 +101,14 @@ pub enum ShaperSpec {
         /// Time with the actuator off between accelerating and decelerating, s (> 0).
         coast_time: f64,
     },
+    /// Your own impulses `[{ time, amplitude }]`, validated; the modes are not used.
+    Custom {
+        /// The impulses, any order (merged when at the same time, shifted to start at 0).
+        impulses: Vec<crate::shaper::Impulse>,
+        /// Divide the amplitudes by their sum (default false).
+        #[serde(default)]
+        normalize: bool,
+    },
 }
 
 fn default_vtol() -> f64 {
@@ -124,6 +133,7 @@ impl ShaperSpec {
             ShaperSpec::Umei { .. } => "umei",
             ShaperSpec::Bangbang { .. } => "bangbang",
             ShaperSpec::Onoff { .. } => "onoff",
+            ShaperSpec::Custom { .. } => "custom",
         }
     }
 
@@ -259,11 +269,17 @@ pub const FAMILIES: &[FamilyInfo] = &[
         parameters: &["distance", "maxAcceleration", "coastTime"],
         source: "Singhose 2009 §5, Fig. 14",
     },
+    FamilyInfo {
+        name: "custom",
+        title: "Custom",
+        guarantee: "none beyond a valid impulse sequence (modes are not used)",
+        parameters: &["impulses", "normalize"],
+        source: "your own",
+    },
 ];
 
 /// What a designed shaper promises, checked by [`verify`] before it is returned.
 #[derive(Debug, Clone, PartialEq)]
-#[allow(dead_code)] // AtMost and Valid are for the solved and custom families being added
 pub(crate) enum Guarantee {
     /// V = 0 (to rounding) at every listed (frequency in Hz, damping ratio) point.
     ZeroAt(Vec<(f64, f64)>),
@@ -353,6 +369,10 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
                 ]),
             )
         }
+        ShaperSpec::Custom {
+            impulses,
+            normalize,
+        } => (custom::custom(impulses, *normalize)?, Guarantee::Valid),
         ShaperSpec::Onoff {
             distance,
             max_acceleration,
