@@ -11,7 +11,7 @@ const FIELD_INPUT = [
   [/^modes\[0\]\.damping/, 'damping'],
   [/^(shaper\.)?derivatives/, 'derivatives'],
   [/^(shaper\.)?family|^shaper$/, 'family'],
-  [/^view\.vtol|^vtol/, 'vtol'],
+  [/^view\.vtol|^(shaper\.)?vtol/, 'vtol'],
 ];
 
 function readNumber(id) {
@@ -23,6 +23,9 @@ function readState() {
   const family = $('family').value;
   const shaper = { family };
   if (family === 'zvdn') shaper.derivatives = readNumber('derivatives');
+  // EI-type families design their humps at the page's tolerable vibration.
+  const info = familyTable.find((f) => f.name === family);
+  if (info && info.parameters.includes('vtol')) shaper.vtol = readNumber('vtol') / 100;
   return {
     modes: [{ frequencyHz: readNumber('frequency'), damping: readNumber('damping') }],
     shaper,
@@ -123,7 +126,10 @@ let familyTable = [];
 
 async function main() {
   await init();
-  familyTable = families();
+  // Only the families whose parameters this page has inputs for (the others — eihump,
+  // bangbang, onoff, custom — need fields it does not show yet).
+  const supported = new Set(['derivatives', 'vtol']);
+  familyTable = families().filter((f) => f.parameters.every((p) => supported.has(p)));
   $('family').replaceChildren(
     ...familyTable.map((f) => {
       const option = document.createElement('option');

@@ -36,9 +36,10 @@
 //! their fitting error (see the tests); for one hump the fits keep t₃ = T_d, which the exact
 //! solution does not (it differs by ~2·10⁻³ T_d at ζ = 0.1).
 //!
-//! The family ends where its outermost zero runs off to infinite frequency (about ζ = 0.69
-//! for EI, 0.45 for two humps, 0.28 for three at Vtol = 5 %; less for more humps or larger
-//! Vtol): beyond that no such shaper exists and the design reports it.
+//! The family ends where its outermost zero runs off to infinite frequency (the design stops
+//! following it once that zero passes 20× the mode): at Vtol = 5 % near ζ = 0.68 for EI, 0.44
+//! for two humps, 0.28 for three, 0.22 for four; less for larger Vtol, more for smaller.
+//! Beyond that no such shaper exists and the design reports it, naming the mode's `damping`.
 
 use super::equations::{continue_in_damping, to_shaper, Equation, Param, System};
 use super::Guarantee;
