@@ -440,6 +440,14 @@ fn specs_and_errors() {
             "distance",
         ),
         (r#"{"family":"umei","vtol":2}"#, "vtol"),
+        (
+            r#"{"family":"bangbang","distance":1e-12,"maxAcceleration":1}"#,
+            "distance",
+        ),
+        (
+            r#"{"family":"onoff","distance":1e-9,"maxAcceleration":1,"coastTime":0.1}"#,
+            "distance",
+        ),
     ];
     for (json, field) in bad {
         let err = design(&request(&[(2.0, 0.05)], json)).unwrap_err();

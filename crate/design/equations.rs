@@ -238,6 +238,10 @@ impl System {
 
 /// Largest residual accepted as a solution (the equations are scaled to order one).
 const RESIDUAL_TOLERANCE: f64 = 1e-12;
+/// Residual accepted when rounding stops Newton (its step is below 1e-14 of the unknowns):
+/// a row's terms may be much larger than its value, e.g. the position of a short move. The
+/// designs' own checks then decide whether the result is good enough.
+const ROUNDING_LIMITED_TOLERANCE: f64 = 1e-9;
 /// Newton iterations per solve.
 const MAX_NEWTON_ITERATIONS: usize = 60;
 
@@ -261,6 +265,9 @@ pub(crate) fn newton(system: &System, x0: &DVector<f64>) -> Option<DVector<f64>>
         let step = j.clone().lu().solve(&(-&f))?;
         if !step.iter().all(|s| s.is_finite()) {
             return None;
+        }
+        if step.amax() <= 1e-14 * (1.0 + x.amax()) {
+            return (f.amax() <= ROUNDING_LIMITED_TOLERANCE).then_some(x);
         }
         let mut lambda = 1.0;
         loop {

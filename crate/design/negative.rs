@@ -61,6 +61,14 @@ use std::f64::consts::PI;
 /// where its upper zero escapes).
 const MAX_ZERO_RATIO: f64 = 20.0;
 
+/// Shortest on/off pulse accepted, radians of the mode (1/2000 of a period): below it the
+/// move's position is lost in rounding against its duration.
+const MIN_PULSE: f64 = PI / 1000.0;
+/// Smallest bang-bang move accepted, as distance / (maxAcceleration · T²): it lasts about
+/// 2 % of a period; shorter moves are below any actuator's resolution and lose their
+/// position to rounding.
+pub const MIN_BANG_BANG_MOVE: f64 = 1e-8;
+
 /// Longest bang-bang or on/off move accepted, in periods of the mode.
 pub const MAX_MOVE_PERIODS: f64 = 1000.0;
 
@@ -351,7 +359,7 @@ fn bang_bang_undamped(delta: f64) -> Result<DVector<f64>> {
 
 /// The bang-bang system at damping `zeta` for a move of size `delta` (radians²).
 fn bang_bang_system(zeta: f64, delta: f64) -> System {
-    let scale = delta.max(1.0);
+    let scale = delta;
     System {
         zeta,
         amplitudes: [1.0, -2.0, 2.0, -2.0, 1.0]
@@ -457,6 +465,17 @@ fn end_cluster_starts(zeta: f64, delta: f64) -> Vec<DVector<f64>> {
 /// a proof of time-optimality; the tests compare it with a brute-force scan.
 pub fn bang_bang(mode: &Mode, distance: f64, max_acceleration: f64) -> Result<Shaper> {
     let delta = move_size(mode, distance, max_acceleration)?;
+    // δ = ω²D/a = 4π² D/(aT²).
+    if delta < MIN_BANG_BANG_MOVE * 4.0 * PI * PI {
+        return Err(Error::invalid(
+            "distance",
+            format!(
+                "too short: distance / (maxAcceleration · T²) must be at least \
+                 {MIN_BANG_BANG_MOVE:e} (T the mode's period), got {:e}",
+                delta / (4.0 * PI * PI)
+            ),
+        ));
+    }
     let zeta = mode.damping();
     let omega = mode.omega_rad_s();
     let undamped = bang_bang_undamped(delta)?;
@@ -522,9 +541,20 @@ pub fn on_off(
     let omega = mode.omega_rad_s();
     let c = coast_time * omega;
     check_duration(c)?;
-    // ζ = 0: δ = 2p(π + p + c).
-    let p = (-(PI + c) + ((PI + c).powi(2) + 2.0 * delta).sqrt()) / 2.0;
-    if !(p > 0.0 && p < PI * (1.0 - 1e-6)) {
+    // ζ = 0: δ = 2p(π + p + c), p = δ / ((π + c) + √((π + c)² + 2δ)) without cancellation.
+    let p = delta / ((PI + c) + ((PI + c).powi(2) + 2.0 * delta).sqrt());
+    if p < MIN_PULSE {
+        return Err(Error::invalid(
+            "distance",
+            format!(
+                "too short for an on/off move with this coast: its pulses would last {:.3e} s, \
+                 under 1/2000 of a period of the mode; a shorter coastTime lengthens them, or use \
+                 bangbang",
+                p / omega
+            ),
+        ));
+    }
+    if p >= PI * (1.0 - 1e-6) {
         let min_coast = (delta / (2.0 * PI) - 2.0 * PI) / omega;
         return Err(Error::invalid(
             "coastTime",
@@ -537,7 +567,7 @@ pub fn on_off(
     let s = PI + p + c;
     check_duration(s + PI + p)?;
     let x0 = DVector::from_vec(vec![p, PI, PI + p, s, s + p, s + PI, s + PI + p]);
-    let scale = delta.max(1.0);
+    let scale = delta;
     let system_at = |zeta| System {
         zeta,
         amplitudes: [1.0, -1.0, 1.0, -1.0, -1.0, 1.0, -1.0, 1.0]
