@@ -27,14 +27,15 @@
 //!
 //! ## With damping
 //! The published damped EI shapers are curve fits in ζ. Here they are solved exactly: with
-//! the n + 2 amplitudes and n + 1 times (t₁ = 0) free, and the hump and zero frequencies as
+//! the n + 2 amplitudes and the n + 1 times after t₁ = 0 free, and the hump and zero frequencies as
 //! further unknowns, the equations are Σ Aᵢ = 1; at each hump V = Vtol and dV/dω = 0 (two
 //! each); at each zero P = 0 (two each); the middle hump (n odd) or the middle zero (n even)
 //! is pinned at the modelling frequency. That is 4n + 3 equations in 4n + 3 unknowns, solved
 //! by Newton's method from the ζ = 0 closed form with continuation in ζ
-//! ([`super::equations`]). The two-hump result agrees with Singhose's published curve fits to
-//! their fitting error (see the tests); for one hump the fits keep t₃ = T_d, which the exact
-//! solution does not (it differs by ~2·10⁻³ T_d at ζ = 0.1).
+//! (`design/equations.rs`). The two-hump result agrees with Singhose's published curve fits to
+//! their fitting error (see the tests); for one hump the amplitudes agree to 2·10⁻⁴, but the
+//! fits keep t₃ = T_d, which the exact solution does not: at ζ = 0.1 its t₂ and t₃ differ from
+//! the fits by 2·10⁻³ and 4·10⁻³ T_d.
 //!
 //! The family ends where its outermost zero runs off to infinite frequency (the design stops
 //! following it once that zero passes 20× the mode): at Vtol = 5 % near ζ = 0.68 for EI, 0.44

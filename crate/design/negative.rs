@@ -1,7 +1,7 @@
 //! Shapers with negative impulses: unity-magnitude (UM-ZV, UM-ZVD, UM-EI), the time-optimal
 //! bang-bang shaper and the fuel-efficient on/off shaper (Singhose 2009 §5, Figs. 13–14).
 //!
-//! All are solved exactly with damping by Newton's method ([`super::equations`]) from an
+//! All are solved exactly with damping by Newton's method (`design/equations.rs`) from an
 //! undamped solution, with continuation in ζ. The review gives the idea and the figures; the
 //! constraint sets below are reconstructed from it and from the papers it cites (Singhose,
 //! Seering & Singer 1997, "Time-optimal negative input shapers"; Vaughan, Yano & Singhose 2009
