@@ -33,7 +33,7 @@
 //! is pinned at the modelling frequency. That is 4n + 3 equations in 4n + 3 unknowns, solved
 //! by Newton's method from the ζ = 0 closed form with continuation in ζ
 //! (`design/equations.rs`). The two-hump result agrees with Singhose's published curve fits to
-//! their fitting error (see the tests); for one hump the amplitudes agree to 2·10⁻⁴, but the
+//! their fitting error (see the tests); for one hump the amplitudes agree to 3·10⁻⁴, but the
 //! fits keep t₃ = T_d, which the exact solution does not: at ζ = 0.1 its t₂ and t₃ differ from
 //! the fits by 2·10⁻³ and 4·10⁻³ T_d.
 //!

@@ -14,7 +14,7 @@
 //! positive shaper with the same constraints. The times are the unknowns:
 //!
 //! - **UM-ZV**: [1, −1, 1]; V = 0 at the mode (2 equations, t₂ and t₃). At ζ = 0,
-//!   t = [0, T/6, T/3] (1 − 2cos(ωT/6) = 0 centred on T/6).
+//!   t = [0, T/6, T/3]: centred on T/6 the phasor is 2cos(ωT/6) − 1, zero at ω = 2π/T.
 //! - **UM-ZVD**: [1, −1, 1, −1, 1]; V = 0 and ∂P/∂ω = 0 at the mode (4 equations, 4 times).
 //!   At ζ = 0 the solution is symmetric, t = [0, x − y, x, x + y, 2x]/ω, with
 //!   1 + 2cos x − 2cos y = 0 and x sin x = y sin y; x is found by bisection on (π/3, π)
