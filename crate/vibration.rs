@@ -299,3 +299,68 @@ pub fn vibration_on_grid(
         }
     }
 }
+
+/// The complex residual-vibration phasor of an impulse sequence and its derivatives, for the
+/// designs that solve for impulses with Newton's method (EI with damping, unity-magnitude,
+/// bang-bang).
+///
+/// With t_L the time of the *last impulse of the slice* (t_n for a sorted shaper),
+/// P(ω) = Σ Aᵢ e^{−ζω(t_L − tᵢ)} e^{iω_d tᵢ}, so |P| is exactly V of Singhose 2009 eq. 11
+/// ([`vibration_rad`]). Writing P = Σ Aᵢ e^{ω sᵢ} with sᵢ = λtᵢ − ζt_L and λ = ζ + i√(1−ζ²):
+///
+/// - ∂P/∂ω = Σ Aᵢ sᵢ e^{ωsᵢ}, ∂²P/∂ω² = Σ Aᵢ sᵢ² e^{ωsᵢ};
+/// - ∂P/∂Aₖ = e^{ωsₖ}, ∂²P/∂ω∂Aₖ = sₖ e^{ωsₖ};
+/// - ∂P/∂tₖ = ωλAₖe^{ωsₖ} − [k = L] ωζP,
+///   ∂²P/∂ω∂tₖ = λAₖ(1 + ωsₖ)e^{ωsₖ} − [k = L] ζ(P + ω ∂P/∂ω).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VibrationPhasor {
+    /// P(ω); its modulus is V.
+    pub value: nalgebra::Complex<f64>,
+    /// ∂P/∂ω.
+    pub d_omega: nalgebra::Complex<f64>,
+    /// ∂²P/∂ω².
+    pub d_omega2: nalgebra::Complex<f64>,
+    /// ∂P/∂Aₖ for each impulse k.
+    pub d_amplitude: Vec<nalgebra::Complex<f64>>,
+    /// ∂P/∂tₖ for each impulse k (the last one also moves the reference time t_L).
+    pub d_time: Vec<nalgebra::Complex<f64>>,
+    /// ∂²P/∂ω∂Aₖ for each impulse k.
+    pub d_omega_d_amplitude: Vec<nalgebra::Complex<f64>>,
+    /// ∂²P/∂ω∂tₖ for each impulse k.
+    pub d_omega_d_time: Vec<nalgebra::Complex<f64>>,
+}
+
+/// [`VibrationPhasor`] of `impulses` (in the given order; the last one is the reference) at
+/// undamped frequency `omega` (rad/s) and damping ratio `zeta` (0 ≤ ζ < 1, the caller's to
+/// ensure).
+pub fn vibration_phasor(impulses: &[Impulse], omega: f64, zeta: f64) -> VibrationPhasor {
+    let lambda = nalgebra::Complex::new(zeta, (1.0 - zeta * zeta).sqrt());
+    let t_last = impulses.last().map_or(0.0, |imp| imp.time);
+    let n = impulses.len();
+    let mut out = VibrationPhasor {
+        value: nalgebra::Complex::new(0.0, 0.0),
+        d_omega: nalgebra::Complex::new(0.0, 0.0),
+        d_omega2: nalgebra::Complex::new(0.0, 0.0),
+        d_amplitude: Vec::with_capacity(n),
+        d_time: Vec::with_capacity(n),
+        d_omega_d_amplitude: Vec::with_capacity(n),
+        d_omega_d_time: Vec::with_capacity(n),
+    };
+    for imp in impulses {
+        let s = lambda * imp.time - zeta * t_last;
+        let e = (s * omega).exp();
+        out.value += e * imp.amplitude;
+        out.d_omega += s * e * imp.amplitude;
+        out.d_omega2 += s * s * e * imp.amplitude;
+        out.d_amplitude.push(e);
+        out.d_omega_d_amplitude.push(s * e);
+        out.d_time.push(lambda * e * (omega * imp.amplitude));
+        out.d_omega_d_time
+            .push(lambda * (s * omega + 1.0) * e * imp.amplitude);
+    }
+    if let (Some(dt), Some(dwdt)) = (out.d_time.last_mut(), out.d_omega_d_time.last_mut()) {
+        *dt -= out.value * (omega * zeta);
+        *dwdt -= (out.value + out.d_omega * omega) * zeta;
+    }
+    out
+}

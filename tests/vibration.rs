@@ -197,3 +197,30 @@ fn insensitivity_of_a_long_shaper_is_bounded_and_correct() {
         "the robust bands of the four modes merge: {band:?}"
     );
 }
+/// The phasor used by the Newton designs has |P| = V (eq. 11) and ∂P/∂ω, ∂²P/∂ω² matching
+/// central differences.
+#[wasm_bindgen_test(unsupported = test)]
+fn phasor_modulus_is_v_and_its_frequency_derivatives_match_differences() {
+    use input_shaping::vibration::{vibration_phasor, vibration_rad};
+    let s = shaper(&[(0.0, 0.7), (0.13, -0.4), (0.31, 0.5), (0.5, 0.2)]);
+    for z in [0.0, 0.03, 0.25, 0.6] {
+        for w in [0.5, 7.0, 19.0] {
+            let p = vibration_phasor(s.impulses(), w, z);
+            close(
+                p.value.norm(),
+                vibration_rad(s.impulses(), w, z),
+                1e-14,
+                "|P| = V",
+            );
+            let h = 1e-5;
+            let (pp, pm) = (
+                vibration_phasor(s.impulses(), w + h, z),
+                vibration_phasor(s.impulses(), w - h, z),
+            );
+            let d = (pp.value - pm.value) / (2.0 * h);
+            let d2 = (pp.d_omega - pm.d_omega) / (2.0 * h);
+            close((d - p.d_omega).norm(), 0.0, 1e-8, "∂P/∂ω");
+            close((d2 - p.d_omega2).norm(), 0.0, 1e-7, "∂²P/∂ω²");
+        }
+    }
+}

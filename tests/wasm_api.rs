@@ -197,3 +197,49 @@ fn spectrum_of_a_shaped_step_is_zero_at_the_mode() {
     let modes: js_sys::Array = get(&r, "modesHz").dyn_into().unwrap();
     assert_eq!(modes.get(0).as_f64(), Some(2.0));
 }
+
+/// The robust families cross the JS boundary with their camelCase parameters.
+#[wasm_bindgen_test]
+fn robust_families_through_js() {
+    for (spec, n) in [
+        (
+            r#"{"family":"ei","modes":[{"frequencyHz":2,"damping":0.1}]}"#,
+            3,
+        ),
+        (
+            r#"{"family":"eihump","humps":3,"vtol":0.05,"modes":[{"frequencyHz":2}]}"#,
+            5,
+        ),
+        (
+            r#"{"family":"mzv","modes":[{"frequencyHz":40,"damping":0.1}]}"#,
+            3,
+        ),
+        (
+            r#"{"family":"umei","vtol":0.05,"modes":[{"frequencyHz":2}]}"#,
+            5,
+        ),
+        (
+            r#"{"family":"bangbang","distance":0.2,"maxAcceleration":3,"modes":[{"frequencyHz":2,"damping":0.05}]}"#,
+            5,
+        ),
+        (
+            r#"{"family":"onoff","distance":0.2,"maxAcceleration":3,"coastTime":0.3,"modes":[{"frequencyHz":2}]}"#,
+            8,
+        ),
+        (
+            r#"{"family":"custom","impulses":[{"time":0,"amplitude":1},{"time":0.1,"amplitude":3}],"normalize":true,"modes":[{"frequencyHz":2}]}"#,
+            2,
+        ),
+    ] {
+        let shaper = wasm::design(js(spec)).unwrap();
+        let impulses: js_sys::Array = get(&shaper, "impulses").dyn_into().unwrap();
+        assert_eq!(impulses.length(), n, "{spec}");
+    }
+    let (message, field) = error_message(
+        wasm::design(js(
+            r#"{"family":"ei3","modes":[{"frequencyHz":2,"damping":0.6}]}"#,
+        ))
+        .unwrap_err(),
+    );
+    assert_eq!(field.as_deref(), Some("modes[0].damping"), "{message}");
+}

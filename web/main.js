@@ -99,10 +99,14 @@ function shaperCard(spec, k) {
     const pinfo = paramInfo(name, spec.family);
     if (!(name in spec) && pinfo.default !== undefined && !pinfo.optional) spec[name] = pinfo.default;
     let input;
-    if (pinfo.kind === 'select') {
+    if (pinfo.kind === 'select' || pinfo.kind === 'boolean') {
+      const options = pinfo.kind === 'boolean' ? ['false', 'true'] : pinfo.options;
       input = el('select', { id: `shaper-${k}-${name}`, dataset: { field: `shapers[${k}].${name}` } },
-        ...pinfo.options.map((o) => el('option', { value: o }, o)));
-      input.value = spec[name];
+        ...options.map((o) => el('option', { value: o }, pinfo.kind === 'boolean' ? (o === 'true' ? 'yes' : 'no') : o)));
+      input.value = formatParam(pinfo, spec[name]);
+    } else if (pinfo.kind === 'pairs') {
+      input = el('textarea', { id: `shaper-${k}-${name}`, rows: '4', dataset: { field: `shapers[${k}].${name}` } });
+      input.value = formatParam(pinfo, spec[name]);
     } else {
       input = el('input', {
         id: `shaper-${k}-${name}`, type: pinfo.kind === 'numbers' ? 'text' : 'number', step: pinfo.kind === 'integer' ? '1' : 'any',

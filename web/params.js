@@ -1,10 +1,16 @@
 // How each family parameter is edited on the page. Parameters are named as in a design spec
 // (README, "Shaper families"); a parameter not listed here gets a plain number field.
 // kind: 'number' | 'integer' | 'numbers' (comma-separated list) | 'percent' (fraction shown in %)
-// | 'select' (with `options`). `optional`: a blank field leaves the parameter out of the spec
+// | 'select' (with `options`) | 'boolean' | 'pairs' (impulses, one "time, amplitude" per line). `optional`: a blank field leaves the parameter out of the spec
 // (the core's default applies). FAMILY_PARAMS overrides PARAMS for one family.
 export const PARAMS = {
   derivatives: { label: 'Zero derivatives n', kind: 'integer', min: 0, max: 30, default: 3 },
+  vtol: { label: 'Hump height V (%)', kind: 'percent', default: 0.05 },
+  humps: { label: 'Humps n', kind: 'integer', min: 1, max: 10, default: 2 },
+  distance: { label: 'Move distance', kind: 'number', default: 1 },
+  maxAcceleration: { label: 'Max acceleration (distance/s²)', kind: 'number', default: 10 },
+  coastTime: { label: 'Coast time (s)', kind: 'number', default: 0.5 },
+  normalize: { label: 'Normalise amplitudes to sum 1', kind: 'boolean', default: false },
   periodS: { label: 'Controller period T (s)', kind: 'number', default: 0.012 },
   delaySamples: { label: 'Ramp delay m (periods; blank = free, 0 = full compensation)', kind: 'integer', optional: true, default: 17 },
   weight: { label: 'Control-error weight Q', kind: 'number', default: 0.1 },
@@ -17,6 +23,13 @@ export const PARAMS = {
 };
 
 export const FAMILY_PARAMS = {
+  custom: {
+    impulses: {
+      label: 'Impulses: one "time (s), amplitude" per line',
+      kind: 'pairs',
+      default: [{ time: 0, amplitude: 0.5 }, { time: 0.25, amplitude: 0.5 }],
+    },
+  },
   sampled: {
     impulses: { label: 'Impulses n', kind: 'integer', min: 2, max: 256, default: 36 },
     derivatives: { label: 'Zero derivatives', kind: 'integer', min: 0, max: 3, default: 1 },
@@ -37,6 +50,13 @@ export function parseParam(info, text) {
     return t === '' ? [] : t.split(/[,\s;]+/).filter(Boolean).map(Number);
   }
   if (info.kind === 'select') return t;
+  if (info.kind === 'boolean') return t === 'true';
+  if (info.kind === 'pairs') {
+    return t.split(/\n+/).map((l) => l.trim()).filter(Boolean).map((line) => {
+      const [time, amplitude] = line.split(/[,;\s]+/).map((x) => (x === undefined || x === '' ? NaN : Number(x)));
+      return { time, amplitude };
+    });
+  }
   if (t === '') return NaN;
   const v = Number(t);
   return info.kind === 'percent' ? v / 100 : v;
@@ -46,6 +66,8 @@ export function parseParam(info, text) {
 export function formatParam(info, value) {
   if (value === undefined || value === null) return '';
   if (info.kind === 'numbers') return Array.isArray(value) ? value.join(', ') : String(value);
+  if (info.kind === 'pairs') return Array.isArray(value) ? value.map((p) => `${p?.time}, ${p?.amplitude}`).join('\n') : '';
+  if (info.kind === 'boolean') return String(Boolean(value));
   if (info.kind === 'percent') return Number.isFinite(value) ? String(+(value * 100).toPrecision(10)) : '';
   return String(value);
 }

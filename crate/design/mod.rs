@@ -12,6 +12,12 @@ pub mod quantize;
 pub mod sampled;
 pub mod zero_vibration;
 
+pub mod custom;
+pub(crate) mod equations;
+pub mod extra_insensitive;
+pub mod modified;
+pub mod negative;
+
 use crate::error::{Error, Result};
 use crate::mode::{Mode, ModeSpec};
 use crate::shaper::Shaper;
@@ -37,6 +43,81 @@ pub enum ShaperSpec {
     /// Impulses on the controller period with a prescribed ramp delay and the least control
     /// error (Kamel, Lange & Hirzinger); parameters in [`sampled::SampledSpec`].
     Sampled(sampled::SampledSpec),
+    /// Extra-insensitive: V = `vtol` with zero slope at the mode (a hump), zeros either side;
+    /// 3 impulses, about 1 period (Singhose 2009 §3.1, Fig. 7), solved exactly with damping.
+    Ei {
+        /// Height of the hump, fraction (default 0.05 = 5 %), 0.001 … 0.5.
+        #[serde(default = "default_vtol")]
+        vtol: f64,
+    },
+    /// Two-hump EI: humps of height `vtol` either side of the mode, V = 0 at the mode;
+    /// 4 impulses, about 1½ periods.
+    Ei2 {
+        /// Height of the humps, fraction (default 0.05).
+        #[serde(default = "default_vtol")]
+        vtol: f64,
+    },
+    /// Three-hump EI: the middle hump at the mode; 5 impulses, about 2 periods.
+    Ei3 {
+        /// Height of the humps, fraction (default 0.05).
+        #[serde(default = "default_vtol")]
+        vtol: f64,
+    },
+    /// n-hump EI: `humps` humps of height `vtol`, n + 2 impulses, about (n+1)/2 periods.
+    Eihump {
+        /// Number of humps n, 1 … [`extra_insensitive::MAX_HUMPS`] (1 = EI).
+        humps: u32,
+        /// Height of the humps, fraction (default 0.05).
+        #[serde(default = "default_vtol")]
+        vtol: f64,
+    },
+    /// Klipper's modified ZV: 3 impulses over 0.75 damped period, V = 0 at the mode and near
+    /// 5/3 of it (Klipper shaper_defs.py).
+    Mzv,
+    /// Unity-magnitude ZV: [1, −1, 1], V = 0 at the mode; T/3 long at ζ = 0
+    /// (Singhose 2009 §5).
+    Umzv,
+    /// Unity-magnitude ZVD: [1, −1, 1, −1, 1], V = 0 and dV/dω = 0 at the mode.
+    Umzvd,
+    /// Unity-magnitude EI: [1, −1, 1, −1, 1], a hump V = `vtol` at the mode.
+    Umei {
+        /// Height of the hump, fraction (default 0.05).
+        #[serde(default = "default_vtol")]
+        vtol: f64,
+    },
+    /// Time-optimal rest-to-rest move of one flexible mode plus rigid body: [1, −2, 2, −2, 1],
+    /// amplitudes sum to 0 — convolve with a step of height `maxAcceleration` (Singhose 2009
+    /// Fig. 13).
+    #[serde(rename_all = "camelCase")]
+    Bangbang {
+        /// Move distance (any length unit).
+        distance: f64,
+        /// Actuator acceleration limit (same length unit per s²).
+        max_acceleration: f64,
+    },
+    /// Fuel-efficient on/off move: [1, −1, 1, −1, −1, 1, −1, 1] with a coast (Singhose 2009
+    /// Fig. 14); amplitudes sum to 0, applied like `bangbang`.
+    #[serde(rename_all = "camelCase")]
+    Onoff {
+        /// Move distance (any length unit).
+        distance: f64,
+        /// Actuator acceleration limit (same length unit per s²).
+        max_acceleration: f64,
+        /// Time with the actuator off between accelerating and decelerating, s (> 0).
+        coast_time: f64,
+    },
+    /// Your own impulses `[{ time, amplitude }]`, validated; the modes are not used.
+    Custom {
+        /// The impulses, any order (merged when at the same time, shifted to start at 0).
+        impulses: Vec<crate::shaper::Impulse>,
+        /// Divide the amplitudes by their sum (default false).
+        #[serde(default)]
+        normalize: bool,
+    },
+}
+
+fn default_vtol() -> f64 {
+    extra_insensitive::DEFAULT_VTOL
 }
 
 impl ShaperSpec {
@@ -48,6 +129,17 @@ impl ShaperSpec {
             ShaperSpec::Zvdd => "zvdd",
             ShaperSpec::Zvdn { .. } => "zvdn",
             ShaperSpec::Sampled(_) => "sampled",
+            ShaperSpec::Ei { .. } => "ei",
+            ShaperSpec::Ei2 { .. } => "ei2",
+            ShaperSpec::Ei3 { .. } => "ei3",
+            ShaperSpec::Eihump { .. } => "eihump",
+            ShaperSpec::Mzv => "mzv",
+            ShaperSpec::Umzv => "umzv",
+            ShaperSpec::Umzvd => "umzvd",
+            ShaperSpec::Umei { .. } => "umei",
+            ShaperSpec::Bangbang { .. } => "bangbang",
+            ShaperSpec::Onoff { .. } => "onoff",
+            ShaperSpec::Custom { .. } => "custom",
         }
     }
 
@@ -134,12 +226,99 @@ pub const FAMILIES: &[FamilyInfo] = &[
         ],
         source: "Kamel, Lange & Hirzinger, eqs. 4-25",
     },
+    FamilyInfo {
+        name: "ei",
+        title: "EI",
+        guarantee: "V = vtol with zero slope at each mode, V = 0 either side; exact with damping",
+        parameters: &["vtol"],
+        source: "Singhose 2009 §3.1, Fig. 7; solved by Newton from the ζ = 0 closed form",
+    },
+    FamilyInfo {
+        name: "ei2",
+        title: "Two-hump EI",
+        guarantee: "two humps V = vtol around each mode, V = 0 at the mode and beyond the humps",
+        parameters: &["vtol"],
+        source: "Singhose 2009 §3.1, Fig. 11; Singhose et al. 1997 (multi-hump)",
+    },
+    FamilyInfo {
+        name: "ei3",
+        title: "Three-hump EI",
+        guarantee: "three humps V = vtol (the middle one at each mode), four zeros",
+        parameters: &["vtol"],
+        source: "Singhose 2009 §3.1, Fig. 11; Singhose et al. 1997 (multi-hump)",
+    },
+    FamilyInfo {
+        name: "eihump",
+        title: "n-hump EI",
+        guarantee: "n humps V = vtol with zero slope, n + 1 zeros around them",
+        parameters: &["humps", "vtol"],
+        source: "Singhose 2009 §3.1; Chebyshev closed form at ζ = 0, Newton with damping",
+    },
+    FamilyInfo {
+        name: "mzv",
+        title: "MZV (Klipper)",
+        guarantee: "V = 0 at each mode; second zero near 5/3 of it; 0.75 damped period",
+        parameters: &[],
+        source: "Klipper klippy/extras/shaper_defs.py get_mzv_shaper",
+    },
+    FamilyInfo {
+        name: "umzv",
+        title: "UM-ZV",
+        guarantee: "V = 0 at each mode; amplitudes +1, -1, +1 (on/off command)",
+        parameters: &[],
+        source: "Singhose 2009 §5; Singhose, Seering & Singer 1997 (negative shapers)",
+    },
+    FamilyInfo {
+        name: "umzvd",
+        title: "UM-ZVD",
+        guarantee: "V = 0 and dV/dω = 0 at each mode; amplitudes ±1",
+        parameters: &[],
+        source: "Singhose 2009 §5; Singhose, Seering & Singer 1997 (negative shapers)",
+    },
+    FamilyInfo {
+        name: "umei",
+        title: "UM-EI",
+        guarantee: "hump V = vtol at the mode, zeros either side; amplitudes ±1",
+        parameters: &["vtol"],
+        source: "Singhose 2009 §5; Vaughan, Yano & Singhose 2009",
+    },
+    FamilyInfo {
+        name: "bangbang",
+        title: "Time-optimal bang-bang",
+        guarantee: "rest-to-rest move of `distance`, V = 0 at the mode; amplitudes sum to 0",
+        parameters: &["distance", "maxAcceleration"],
+        source: "Singhose 2009 §5, Fig. 13",
+    },
+    FamilyInfo {
+        name: "onoff",
+        title: "Fuel-efficient on/off",
+        guarantee: "rest-to-rest move with a coast, no vibration while coasting or after",
+        parameters: &["distance", "maxAcceleration", "coastTime"],
+        source: "Singhose 2009 §5, Fig. 14",
+    },
+    FamilyInfo {
+        name: "custom",
+        title: "Custom",
+        guarantee: "none beyond a valid impulse sequence (modes are not used)",
+        parameters: &["impulses", "normalize"],
+        source: "your own",
+    },
 ];
 
 /// What a designed shaper promises, checked by [`verify`] before it is returned.
 #[derive(Debug, Clone, PartialEq)]
-#[allow(dead_code)] // AtMost and Valid are for the solved and custom families being added
 pub(crate) enum Guarantee {
+    /// V = 0 (to rounding) at every listed (frequency in Hz, damping ratio) point.
+    ZeroAt(Vec<(f64, f64)>),
+    /// Every one of these.
+    All(Vec<Guarantee>),
+    /// Amplitudes are acceleration steps of a rigid body that starts at rest: it ends at rest
+    /// (Σ Aᵢ = 0, Σ Aᵢ(t_n − tᵢ) = 0) having travelled ½ Σ Aᵢ(t_n − tᵢ)² = `travel`
+    /// (distance / maxAcceleration, s²).
+    RestToRest {
+        /// Distance over acceleration limit, s².
+        travel: f64,
+    },
     /// V = 0 at every mode (to rounding).
     ZeroAtModes,
     /// V ≤ `vtol` (to `tolerance`) at every listed (frequency in Hz, damping ratio) point.
@@ -196,9 +375,65 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
             sampled::design_for_modes(modes, spec)?.shaper,
             Guarantee::ZeroAtModes,
         ),
+        ShaperSpec::Ei { vtol } => extra_insensitive::for_modes(modes, 1, *vtol)?,
+        ShaperSpec::Ei2 { vtol } => extra_insensitive::for_modes(modes, 2, *vtol)?,
+        ShaperSpec::Ei3 { vtol } => extra_insensitive::for_modes(modes, 3, *vtol)?,
+        ShaperSpec::Eihump { humps, vtol } => extra_insensitive::for_modes(modes, *humps, *vtol)?,
+        ShaperSpec::Mzv => (per_mode(modes, modified::mzv)?, Guarantee::ZeroAtModes),
+        ShaperSpec::Umzv => (per_mode(modes, negative::um_zv)?, Guarantee::ZeroAtModes),
+        ShaperSpec::Umzvd => (per_mode(modes, negative::um_zvd)?, Guarantee::ZeroAtModes),
+        ShaperSpec::Umei { vtol } => negative::um_ei_for_modes(modes, *vtol)?,
+        ShaperSpec::Bangbang {
+            distance,
+            max_acceleration,
+        } => {
+            let mode = negative::single_mode(modes, "bangbang")?;
+            let shaper = negative::bang_bang(mode, *distance, *max_acceleration)
+                .map_err(|e| within_mode(e, 0))?;
+            (
+                shaper,
+                Guarantee::All(vec![
+                    Guarantee::ZeroAtModes,
+                    Guarantee::RestToRest {
+                        travel: distance / max_acceleration,
+                    },
+                ]),
+            )
+        }
+        ShaperSpec::Custom {
+            impulses,
+            normalize,
+        } => (custom::custom(impulses, *normalize)?, Guarantee::Valid),
+        ShaperSpec::Onoff {
+            distance,
+            max_acceleration,
+            coast_time,
+        } => {
+            let mode = negative::single_mode(modes, "onoff")?;
+            let shaper = negative::on_off(mode, *distance, *max_acceleration, *coast_time)
+                .map_err(|e| within_mode(e, 0))?;
+            (
+                shaper,
+                Guarantee::All(vec![
+                    Guarantee::ZeroAtModes,
+                    Guarantee::RestToRest {
+                        travel: distance / max_acceleration,
+                    },
+                ]),
+            )
+        }
     };
     verify(&shaper, modes, &guarantee)?;
     Ok(shaper)
+}
+
+/// Prefixes an error about a mode's own field (`damping`, `frequencyHz`) from the design for
+/// `modes[i]` with that path; errors about the spec's parameters keep their names.
+fn within_mode(e: Error, i: usize) -> Error {
+    match e.field() {
+        Some("damping" | "frequencyHz") => e.within(&format!("modes[{i}]")),
+        _ => e,
+    }
 }
 
 /// Designs a single-mode shaper for each mode and convolves them.
@@ -216,6 +451,51 @@ fn per_mode(modes: &[Mode], single: impl Fn(&Mode) -> Result<Shaper>) -> Result<
 pub(crate) fn verify(shaper: &Shaper, modes: &[Mode], guarantee: &Guarantee) -> Result<()> {
     match guarantee {
         Guarantee::Valid => {}
+        Guarantee::All(all) => {
+            for g in all {
+                verify(shaper, modes, g)?;
+            }
+        }
+        Guarantee::RestToRest { travel } => {
+            let imps = shaper.impulses();
+            let t_n = shaper.duration();
+            let total: f64 = imps.iter().map(|i| i.amplitude.abs()).sum();
+            let sum: f64 = imps.iter().map(|i| i.amplitude).sum();
+            let velocity: f64 = imps.iter().map(|i| i.amplitude * (t_n - i.time)).sum();
+            let position: f64 = imps
+                .iter()
+                .map(|i| 0.5 * i.amplitude * (t_n - i.time).powi(2))
+                .sum();
+            let ok = sum.abs() <= 1e-12 * total
+                && velocity.abs() <= 1e-9 * total * t_n
+                && (position - travel).abs() <= 1e-9 * travel;
+            if !ok {
+                return Err(Error::Infeasible {
+                    reason: format!(
+                        "the designed move does not end at rest at the requested distance \
+                         (Σ A = {sum:.3e}, final velocity {velocity:.3e}, travel {position} \
+                         instead of {travel})"
+                    ),
+                });
+            }
+        }
+        Guarantee::ZeroAt(points) => {
+            for &(f, z) in points {
+                let v = crate::vibration::vibration_rad(
+                    shaper.impulses(),
+                    2.0 * std::f64::consts::PI * f,
+                    z,
+                );
+                if v.is_nan() || v > ZERO_VIBRATION_TOLERANCE {
+                    return Err(Error::Infeasible {
+                        reason: format!(
+                            "the designed shaper leaves V = {v:.3e} at {f} Hz, ζ = {z}, where it \
+                             should vanish"
+                        ),
+                    });
+                }
+            }
+        }
         Guarantee::AtMost {
             vtol,
             points,
