@@ -16,8 +16,10 @@
 //! ## Module map
 //! - [`mode`]: a validated vibration mode (frequency in Hz, damping ratio).
 //! - [`shaper`]: the impulse sequence, convolution, duration, centroid delay.
-//! - [`vibration`]: V(ω, ζ) (Singhose 2009 eq. 11), sensitivity curves, insensitivity bands.
+//! - [`vibration`]: V(ω, ζ) (Singhose 2009 eq. 11), sensitivity curves over frequency and
+//!   damping, the frequency × damping map, insensitivity bands.
 //! - [`design`]: the spec, the table of families, and one file per family of the literature.
+//! - [`robustness`]: robustness against duration across families (Singhose 2009 Fig. 11).
 //! - [`chart`]: charts drawn with plotters on any backend (canvas in the page, SVG in tests).
 //! - [`error`]: the one error type; nothing reachable from the public API panics.
 //! - `wasm` (wasm32 only): the JavaScript API (`design`, `residualVibration`, `sensitivity`, …).
@@ -26,6 +28,7 @@ pub mod chart;
 pub mod design;
 pub mod error;
 pub mod mode;
+pub mod robustness;
 pub mod shaper;
 pub mod vibration;
 
