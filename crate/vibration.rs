@@ -186,8 +186,8 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
     }
     // V oscillates in f with period ~1/duration; sample it at least 40 times per period.
     let step = (0.0025 * f_m).min(1.0 / (40.0 * shaper.duration().max(f64::MIN_POSITIVE)));
-    let high_hz = band_edge(&excess, f_m, f_m * MAX_BAND_RATIO, step);
-    let low_hz = band_edge(&excess, f_m, 0.0, step);
+    let high_hz = band_edge(&excess, f_m, f_m * MAX_BAND_RATIO, step, 2e6);
+    let low_hz = band_edge(&excess, f_m, 0.0, step, 2e6);
     Ok(Insensitivity {
         low_hz,
         high_hz,
@@ -197,13 +197,19 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
 
 /// Walks from `start` (where `excess ≤ 0`) towards `limit` in steps of `step` and returns the
 /// first crossing of `excess` above 0, refined by bisection, or `limit` if there is none. At
-/// most ~2·10⁶ evaluations whatever the inputs (the step is coarsened beyond that).
-fn band_edge(excess: &impl Fn(f64) -> f64, start: f64, limit: f64, step: f64) -> f64 {
+/// most ~`max_steps` evaluations whatever the inputs (the step is coarsened beyond that).
+fn band_edge(
+    excess: &impl Fn(f64) -> f64,
+    start: f64,
+    limit: f64,
+    step: f64,
+    max_steps: f64,
+) -> f64 {
     let direction = if limit >= start { 1.0 } else { -1.0 };
-    let step = step.max((limit - start).abs() / 2e6);
+    let step = step.max((limit - start).abs() / max_steps);
     let mut inside = start;
-    // The step bound above makes this at most ~2·10⁶ rounds; the cap only guards rounding.
-    for _ in 0..2_000_100 {
+    // The step bound above makes this at most ~max_steps rounds; the cap only guards rounding.
+    for _ in 0..(max_steps as usize).saturating_add(100) {
         let next = inside + direction * step;
         let beyond = if direction > 0.0 {
             next >= limit
@@ -375,8 +381,9 @@ pub fn damping_insensitivity(
         });
     }
     let step = 1e-3_f64.min(0.1 / (omega * shaper.duration()).max(f64::MIN_POSITIVE));
-    let high_damping = band_edge(&excess, z_m, MAX_BAND_DAMPING.max(z_m), step);
-    let low_damping = band_edge(&excess, z_m, 0.0, step);
+    // At most 10⁵ steps per side (ζ spans less than 1).
+    let high_damping = band_edge(&excess, z_m, MAX_BAND_DAMPING.max(z_m), step, 1e5);
+    let low_damping = band_edge(&excess, z_m, 0.0, step, 1e5);
     Ok(DampingInsensitivity {
         low_damping,
         high_damping,
