@@ -498,8 +498,8 @@ pub fn sensitivity_map(shaper: &Shaper, options: &SensitivityMapOptions) -> Resu
 
 /// Frequencies advanced side by side in [`sensitivity_map`].
 const MAP_LANES: usize = 8;
-/// Points of a map row between two recomputations from the formula (a multiple of
-/// [`MAP_LANES`]).
+/// Points of a map row between two recomputations from the formula (a multiple of the 8
+/// frequencies advanced side by side).
 pub const MAP_RESEED: usize = 256;
 
 /// Scratch space for evaluating rows of a sensitivity map: allocated once per map.
