@@ -16,7 +16,8 @@
 //! ## Module map
 //! - [`mode`]: a validated vibration mode (frequency in Hz, damping ratio).
 //! - [`shaper`]: the impulse sequence, convolution, duration, centroid delay.
-//! - [`vibration`]: V(ω, ζ) (Singhose 2009 eq. 11), sensitivity curves, insensitivity bands.
+//! - [`vibration`]: V(ω, ζ) (Singhose 2009 eq. 11), sensitivity curves over frequency and
+//!   damping, the frequency × damping map, insensitivity bands.
 //! - [`design`]: the spec, the table of families, and one file per family of the literature.
 //! - [`smoothing`]: Klipper-compatible smoothing and suggested maximum acceleration.
 //! - [`export`]: CSV, JSON, C arrays and RepRapFirmware `M593` lines.
@@ -25,6 +26,7 @@
 //! - [`profile`]: pulse-convolution profiles and their B-spline form (Veciana & Cardona 2011).
 //! - [`plant`]: modal LTI, two-mass spring, nonlinear pendulum; [`simulate`]: their responses;
 //!   [`metrics`]: residual vibration, settling, delay, peaks; [`spectrum`]: |U(f)|.
+//! - [`robustness`]: robustness against duration across families (Singhose 2009 Fig. 11).
 //! - [`chart`]: charts drawn with plotters on any backend (canvas in the page, SVG in tests).
 //! - [`error`]: the one error type; nothing reachable from the public API panics.
 //! - `wasm` (wasm32 only): the JavaScript API (`design`, `residualVibration`, `sensitivity`, …).
@@ -38,6 +40,7 @@ pub mod metrics;
 pub mod mode;
 pub mod plant;
 pub mod profile;
+pub mod robustness;
 pub mod shaper;
 pub mod simulate;
 pub mod smoothing;

@@ -1,8 +1,9 @@
-//! Residual vibration V(ω, ζ) of a shaper, and what is built on it: sensitivity curves and the
-//! insensitivity band.
+//! Residual vibration V(ω, ζ) of a shaper, and what is built on it: sensitivity curves over
+//! frequency and over damping, the frequency × damping map, and insensitivity bands.
 //!
 //! [`vibration_rad`] is the one implementation of Singhose 2009 eq. 11; every curve, chart,
-//! metric and design check calls it.
+//! metric and design check calls it. The one fast path, [`sensitivity_map`], evaluates the same
+//! per-impulse term on a grid by recurrence and is tested point by point against it.
 
 use crate::error::{count, finite, positive, Error, Result};
 use crate::mode::Mode;
@@ -22,16 +23,28 @@ pub const MAX_CURVE_POINTS: usize = 100_000;
 /// `0 ≤ zeta < 1` are the caller's to ensure; with ω = 0 the result is |Σ Aᵢ|.
 pub fn vibration_rad(impulses: &[Impulse], omega: f64, zeta: f64) -> f64 {
     let t_n = impulses.last().map_or(0.0, |imp| imp.time);
-    let omega_d = omega * (1.0 - zeta * zeta).sqrt();
-    let decay = zeta * omega;
+    let damped = (1.0 - zeta * zeta).sqrt();
     let (mut c, mut s) = (0.0, 0.0);
     for imp in impulses {
-        let w = imp.amplitude * (-decay * (t_n - imp.time)).exp();
-        let (sin, cos) = (omega_d * imp.time).sin_cos();
-        c += w * cos;
-        s += w * sin;
+        let (re, im) = term(imp.amplitude, imp.time, t_n, omega, zeta, damped);
+        c += re;
+        s += im;
     }
     c.hypot(s)
+}
+
+/// One impulse's contribution to eq. 11, already multiplied by the factor e^{−ζω t_n}:
+/// A e^{−ζω(t_n − t)} (cos ω_d t, sin ω_d t), with ω_d = ω·`damped` and `damped` = √(1−ζ²).
+///
+/// As a function of ω (ζ fixed) this is A·exp(ω·(−ζ(t_n − t) + i√(1−ζ²) t)): an exponential
+/// in ω, so on evenly spaced frequencies it is a geometric sequence. [`sensitivity_map`] uses
+/// that to step along a row with one complex multiplication per impulse instead of an `exp`
+/// and a `sin_cos`.
+#[inline]
+fn term(amplitude: f64, time: f64, t_n: f64, omega: f64, zeta: f64, damped: f64) -> (f64, f64) {
+    let w = amplitude * (-(zeta * omega) * (t_n - time)).exp();
+    let (sin, cos) = (omega * damped * time).sin_cos();
+    (w * cos, w * sin)
 }
 
 /// Residual vibration V of `shaper` on `mode` (fraction: 0 = none, 1 = as much as unshaped).
@@ -169,13 +182,7 @@ const SCAN_CHUNK: usize = 256;
 /// band edges are bracketed by a scan fine enough for the shaper's duration and refined by
 /// bisection to machine precision.
 pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensitivity> {
-    positive("vtol", vtol)?;
-    if vtol >= 1.0 {
-        return Err(Error::invalid(
-            "vtol",
-            format!("tolerable vibration must be below 1 (100 %), got {vtol}"),
-        ));
-    }
+    tolerable_vibration(vtol)?;
     let f_m = mode.frequency_hz();
     let zeta = mode.damping();
     let threshold = vtol * (1.0 + VTOL_SLACK) + 1e-14;
@@ -228,6 +235,54 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
     })
 }
 
+/// Walks from `start` (where `excess ≤ 0`) towards `limit` in steps of `step` and returns the
+/// first crossing of `excess` above 0, refined by bisection, or `limit` if there is none. At
+/// most ~`max_steps` evaluations whatever the inputs (the step is coarsened beyond that).
+fn band_edge(
+    excess: &impl Fn(f64) -> f64,
+    start: f64,
+    limit: f64,
+    step: f64,
+    max_steps: f64,
+) -> f64 {
+    let direction = if limit >= start { 1.0 } else { -1.0 };
+    let step = step.max((limit - start).abs() / max_steps);
+    let mut inside = start;
+    // The step bound above makes this at most ~max_steps rounds; the cap only guards rounding.
+    for _ in 0..(max_steps as usize).saturating_add(100) {
+        let next = inside + direction * step;
+        let beyond = if direction > 0.0 {
+            next >= limit
+        } else {
+            next <= limit
+        };
+        if beyond {
+            return if excess(limit) > 0.0 {
+                bisect(excess, inside, limit)
+            } else {
+                limit
+            };
+        }
+        if excess(next) > 0.0 {
+            return bisect(excess, inside, next);
+        }
+        inside = next;
+    }
+    inside
+}
+
+/// Checks a tolerable vibration level 0 < `vtol` < 1 (field `vtol`).
+pub(crate) fn tolerable_vibration(vtol: f64) -> Result<f64> {
+    positive("vtol", vtol)?;
+    if vtol >= 1.0 {
+        return Err(Error::invalid(
+            "vtol",
+            format!("tolerable vibration must be below 1 (100 %), got {vtol}"),
+        ));
+    }
+    Ok(vtol)
+}
+
 /// Bisection for the crossing of `g` between `inside` (g ≤ 0) and `outside` (g > 0).
 fn bisect(g: &impl Fn(f64) -> f64, mut inside: f64, mut outside: f64) -> f64 {
     for _ in 0..200 {
@@ -244,15 +299,9 @@ fn bisect(g: &impl Fn(f64) -> f64, mut inside: f64, mut outside: f64) -> f64 {
     0.5 * (inside + outside)
 }
 
-/// Grid points between exact re-seeds of the recurrence in [`vibration_on_grid`].
-const RESEED: usize = 64;
-
-/// V at the evenly spaced frequencies `from_hz + k·step_hz`, k = 0 … n−1, written to `out`
-/// (cleared first). Same quantity as [`vibration_rad`], evaluated by rotating each impulse's
-/// term e^{−ζω(t_n−tᵢ)} e^{iω_d tᵢ} from one frequency to the next with one complex multiply
-/// (the terms are geometric in k) instead of an `exp` and a `sin_cos`; the terms are recomputed
-/// exactly every [`RESEED`] points so rounding cannot accumulate. Agrees with
-/// [`vibration_rad`] to ~1e-13 (tested).
+/// V at the evenly spaced frequencies `from_hz + k·step_hz`, k = 0 … n−1 (`step_hz` may be
+/// negative), written to `out` (cleared first): the same quantity as [`vibration_rad`] by the
+/// map's recurrence (see [`sensitivity_map`]), agreeing with it to ~1e-13 (tested).
 pub fn vibration_on_grid(
     impulses: &[Impulse],
     from_hz: f64,
@@ -262,42 +311,8 @@ pub fn vibration_on_grid(
     out: &mut Vec<f64>,
 ) {
     out.clear();
-    let two_pi = 2.0 * std::f64::consts::PI;
-    let t_n = impulses.last().map_or(0.0, |imp| imp.time);
-    let root = (1.0 - zeta * zeta).sqrt();
-    // Per impulse: the rotation per step (re, im) and the current term (re, im).
-    let rot: Vec<(f64, f64)> = impulses
-        .iter()
-        .map(|imp| {
-            let decay = (-zeta * two_pi * step_hz * (t_n - imp.time)).exp();
-            let (s, c) = (two_pi * step_hz * root * imp.time).sin_cos();
-            (decay * c, decay * s)
-        })
-        .collect();
-    let mut term = vec![(0.0, 0.0); impulses.len()];
-    let mut k = 0;
-    while k < n {
-        let f = from_hz + step_hz * k as f64;
-        let omega = two_pi * f;
-        for (slot, imp) in term.iter_mut().zip(impulses) {
-            let w = imp.amplitude * (-zeta * omega * (t_n - imp.time)).exp();
-            let (s, c) = (omega * root * imp.time).sin_cos();
-            *slot = (w * c, w * s);
-        }
-        let stop = (k + RESEED).min(n);
-        while k < stop {
-            let (mut c, mut s) = (0.0, 0.0);
-            for ((tr, ti), &(rr, ri)) in term.iter_mut().zip(&rot) {
-                c += *tr;
-                s += *ti;
-                let (nr, ni) = (*tr * rr - *ti * ri, *tr * ri + *ti * rr);
-                *tr = nr;
-                *ti = ni;
-            }
-            out.push(c.hypot(s));
-            k += 1;
-        }
-    }
+    out.resize(n, 0.0);
+    RowEvaluator::new(impulses, step_hz).fill(from_hz, zeta, out);
 }
 
 /// The complex residual-vibration phasor of an impulse sequence and its derivatives, for the
@@ -363,4 +378,341 @@ pub fn vibration_phasor(impulses: &[Impulse], omega: f64, zeta: f64) -> Vibratio
         *dwdt -= (out.value + out.d_omega * omega) * zeta;
     }
     out
+}
+/// Checks a plant frequency 0 < f ≤ [`crate::mode::MAX_FREQUENCY_HZ`] given in field `field`.
+fn plant_frequency(field: &str, frequency_hz: f64) -> Result<f64> {
+    positive(field, frequency_hz)?;
+    if frequency_hz > crate::mode::MAX_FREQUENCY_HZ {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must be at most {} Hz, got {frequency_hz}",
+                crate::mode::MAX_FREQUENCY_HZ
+            ),
+        ));
+    }
+    Ok(frequency_hz)
+}
+
+/// Checks a damping range `from` … `to` (0 ≤ from < to < 1) given in fields `from_field`,
+/// `to_field`.
+fn damping_range(from_field: &str, from: f64, to_field: &str, to: f64) -> Result<()> {
+    damping_ratio(from_field, from)?;
+    damping_ratio(to_field, to)?;
+    if to <= from {
+        return Err(Error::invalid(
+            to_field,
+            format!("must be greater than {from_field} ({from}), got {to}"),
+        ));
+    }
+    Ok(())
+}
+
+// ----------------------------------------------------------------------------------------------
+// Sensitivity to the damping ratio
+
+/// Options of a sensitivity curve V(ζ) at a fixed frequency.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct DampingSensitivityOptions {
+    /// Undamped natural frequency of the plant in Hz (> 0).
+    pub frequency_hz: f64,
+    /// First damping ratio, 0 ≤ ζ < 1.
+    pub from_damping: f64,
+    /// Last damping ratio, `from_damping` < ζ < 1.
+    pub to_damping: f64,
+    /// Number of evenly spaced damping ratios, 2 … [`MAX_CURVE_POINTS`].
+    pub points: usize,
+}
+
+/// A sensitivity curve over damping: V at evenly spaced damping ratios, frequency fixed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct DampingSensitivityCurve {
+    /// Damping ratios ζ.
+    pub damping: Vec<f64>,
+    /// Residual vibration (fraction) at each damping ratio.
+    pub vibration: Vec<f64>,
+}
+
+/// The sensitivity curve V(ζ) of `shaper` over a range of damping ratios at one undamped
+/// natural frequency: how much vibration is left when the plant's damping is not the one the
+/// shaper was designed for (Singhose 2009 eq. 11 read as a function of ζ; Fig. 10 is the
+/// surface it is one section of).
+pub fn damping_sensitivity(
+    shaper: &Shaper,
+    options: &DampingSensitivityOptions,
+) -> Result<DampingSensitivityCurve> {
+    let f = plant_frequency("frequencyHz", options.frequency_hz)?;
+    damping_range(
+        "fromDamping",
+        options.from_damping,
+        "toDamping",
+        options.to_damping,
+    )?;
+    count("points", options.points, 2, MAX_CURVE_POINTS)?;
+    let omega = 2.0 * std::f64::consts::PI * f;
+    let damping: Vec<f64> =
+        linspace(options.from_damping, options.to_damping, options.points).collect();
+    let vibration = damping
+        .iter()
+        .map(|&z| vibration_rad(shaper.impulses(), omega, z))
+        .collect();
+    Ok(DampingSensitivityCurve { damping, vibration })
+}
+
+/// The damping insensitivity band of a shaper at a mode: the contiguous range of damping ratios
+/// containing the mode's damping where V ≤ Vtol, at the mode's (undamped natural) frequency.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct DampingInsensitivity {
+    /// Lower band edge (damping ratio, ≥ 0).
+    pub low_damping: f64,
+    /// Upper band edge (damping ratio, ≤ [`MAX_BAND_DAMPING`]).
+    pub high_damping: f64,
+    /// Band width `high_damping − low_damping`, in damping ratio (ζ is already dimensionless, so
+    /// unlike the frequency insensitivity it is not divided by the mode's value). 0 when V
+    /// exceeds Vtol at the mode itself.
+    pub width: f64,
+}
+
+/// Upper edges of a damping band are searched up to this damping ratio.
+pub const MAX_BAND_DAMPING: f64 = 0.999;
+
+/// Damping insensitivity of `shaper` at `mode` (frequency held at the mode's): the band of ζ
+/// where V(ω_m, ζ) ≤ Vtol around the mode's damping. The edges are bracketed by a scan with step
+/// min(10⁻³, 0.1/(ω_m t_n)) in ζ (V's phase ω√(1−ζ²)tᵢ and decay ζω(t_n − tᵢ) change by at most
+/// ~ω t_n per unit of ζ away from ζ → 1) and refined by bisection.
+pub fn damping_insensitivity(
+    shaper: &Shaper,
+    mode: &Mode,
+    vtol: f64,
+) -> Result<DampingInsensitivity> {
+    tolerable_vibration(vtol)?;
+    let omega = mode.omega_rad_s();
+    let z_m = mode.damping();
+    let threshold = vtol * (1.0 + VTOL_SLACK) + 1e-14;
+    let excess = |z: f64| vibration_rad(shaper.impulses(), omega, z) - threshold;
+    if excess(z_m) > 0.0 {
+        return Ok(DampingInsensitivity {
+            low_damping: z_m,
+            high_damping: z_m,
+            width: 0.0,
+        });
+    }
+    let step = 1e-3_f64.min(0.1 / (omega * shaper.duration()).max(f64::MIN_POSITIVE));
+    // At most 10⁵ steps per side (ζ spans less than 1).
+    let high_damping = band_edge(&excess, z_m, MAX_BAND_DAMPING.max(z_m), step, 1e5);
+    let low_damping = band_edge(&excess, z_m, 0.0, step, 1e5);
+    Ok(DampingInsensitivity {
+        low_damping,
+        high_damping,
+        width: high_damping - low_damping,
+    })
+}
+
+// ----------------------------------------------------------------------------------------------
+// The frequency × damping map
+
+/// Most grid points along either axis of a sensitivity map.
+pub const MAX_MAP_AXIS_POINTS: usize = 2000;
+/// Most grid points of a sensitivity map in total (frequency points × damping points).
+pub const MAX_MAP_POINTS: usize = 1_000_000;
+
+/// Options of a sensitivity map V(f, ζ) on an evenly spaced frequency × damping grid.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct SensitivityMapOptions {
+    /// First frequency in Hz (≥ 0).
+    pub from_hz: f64,
+    /// Last frequency in Hz (> `from_hz`).
+    pub to_hz: f64,
+    /// Number of frequencies, 2 … [`MAX_MAP_AXIS_POINTS`].
+    pub frequency_points: usize,
+    /// First damping ratio, 0 ≤ ζ < 1.
+    pub damping_from: f64,
+    /// Last damping ratio, `damping_from` < ζ < 1.
+    pub damping_to: f64,
+    /// Number of damping ratios, 2 … [`MAX_MAP_AXIS_POINTS`]; frequency points × damping points
+    /// at most [`MAX_MAP_POINTS`].
+    pub damping_points: usize,
+}
+
+/// A sensitivity map: V on a frequency × damping grid (Singhose 2009 Fig. 10).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct SensitivityMap {
+    /// Frequencies in Hz (the columns).
+    pub frequency_hz: Vec<f64>,
+    /// Damping ratios (the rows).
+    pub damping: Vec<f64>,
+    /// Residual vibration (fraction), row-major: one row per damping ratio, so
+    /// `vibration[k * frequency_hz.len() + j]` is V at `damping[k]`, `frequency_hz[j]`.
+    pub vibration: Vec<f64>,
+}
+
+impl SensitivityMap {
+    /// Row `k`: V over the frequencies at `damping[k]` (`None` past the last row).
+    pub fn row(&self, k: usize) -> Option<&[f64]> {
+        let n = self.frequency_hz.len();
+        self.vibration
+            .get(k.checked_mul(n)?..k.checked_add(1)?.checked_mul(n)?)
+    }
+
+    /// V at `damping[k]`, `frequency_hz[j]` (`None` outside the grid).
+    pub fn get(&self, k: usize, j: usize) -> Option<f64> {
+        self.row(k)?.get(j).copied()
+    }
+}
+
+/// The sensitivity map V(f, ζ) of `shaper` on an evenly spaced grid (Singhose 2009 Fig. 10).
+///
+/// Each row (one damping ratio) is computed with a geometric recurrence. Per impulse, the term
+/// of eq. 11 is A·exp(ω·(−ζ(t_n − tᵢ) + i√(1−ζ²)tᵢ)), exponential in ω, so its value at f + Δf
+/// is its value at f times a fixed complex factor: a grid point costs one complex
+/// multiply-add per impulse instead of an `exp` and a `sin_cos`. Eight neighbouring
+/// frequencies advance side by side (each by the factor for 8Δf), which lets the compiler
+/// vectorise, and every [`MAP_RESEED`] points the terms are recomputed from the formula, so
+/// rounding never accumulates over more than ~40 multiplications. Tests check
+/// every point against [`vibration_rad`] to 10⁻¹².
+pub fn sensitivity_map(shaper: &Shaper, options: &SensitivityMapOptions) -> Result<SensitivityMap> {
+    frequency_range(options.from_hz, options.to_hz)?;
+    let nf = count(
+        "frequencyPoints",
+        options.frequency_points,
+        2,
+        MAX_MAP_AXIS_POINTS,
+    )?;
+    damping_range(
+        "dampingFrom",
+        options.damping_from,
+        "dampingTo",
+        options.damping_to,
+    )?;
+    let nz = count(
+        "dampingPoints",
+        options.damping_points,
+        2,
+        MAX_MAP_AXIS_POINTS,
+    )?;
+    if nf * nz > MAX_MAP_POINTS {
+        return Err(Error::TooLarge {
+            field: "frequencyPoints × dampingPoints".into(),
+            value: (nf * nz) as f64,
+            limit: MAX_MAP_POINTS as f64,
+        });
+    }
+    let frequency_hz: Vec<f64> = linspace(options.from_hz, options.to_hz, nf).collect();
+    let damping: Vec<f64> = linspace(options.damping_from, options.damping_to, nz).collect();
+    let mut vibration = vec![0.0; nf * nz];
+    let step_hz = (options.to_hz - options.from_hz) / (nf - 1) as f64;
+    let mut rows = RowEvaluator::new(shaper.impulses(), step_hz);
+    for (row, &zeta) in vibration.chunks_exact_mut(nf).zip(&damping) {
+        rows.fill(options.from_hz, zeta, row);
+    }
+    Ok(SensitivityMap {
+        frequency_hz,
+        damping,
+        vibration,
+    })
+}
+
+/// Frequencies advanced side by side in [`sensitivity_map`].
+const MAP_LANES: usize = 8;
+/// Points of a map row between two recomputations from the formula (a multiple of the 8
+/// frequencies advanced side by side).
+pub const MAP_RESEED: usize = 256;
+
+/// Scratch space for evaluating V on evenly spaced frequencies (rows of a sensitivity map,
+/// curves, band traces): allocated once, reused for every row.
+struct RowEvaluator {
+    /// Spacing of the frequencies, Hz (negative to walk downwards).
+    step_hz: f64,
+    /// Impulse times and amplitudes divided by `scale` (so |amplitude| ≤ 1 and C² + S² cannot
+    /// overflow however large the user's amplitudes are).
+    times: Vec<f64>,
+    amplitudes: Vec<f64>,
+    scale: f64,
+    t_n: f64,
+    /// Per impulse, the current contributions (real, imaginary) at the frequencies of the lanes.
+    re: Vec<[f64; MAP_LANES]>,
+    im: Vec<[f64; MAP_LANES]>,
+    /// Per impulse, the factor that advances a contribution by Δf and by `MAP_LANES`·Δf.
+    step: Vec<(f64, f64)>,
+    stride: Vec<(f64, f64)>,
+}
+
+impl RowEvaluator {
+    fn new(impulses: &[Impulse], step_hz: f64) -> Self {
+        let n = impulses.len();
+        let scale = impulses
+            .iter()
+            .map(|imp| imp.amplitude.abs())
+            .fold(0.0, f64::max);
+        // A shaper always has a non-zero amplitude; guard anyway so nothing divides by zero.
+        let scale = if scale > 0.0 { scale } else { 1.0 };
+        RowEvaluator {
+            step_hz,
+            times: impulses.iter().map(|imp| imp.time).collect(),
+            amplitudes: impulses.iter().map(|imp| imp.amplitude / scale).collect(),
+            scale,
+            t_n: impulses.last().map_or(0.0, |imp| imp.time),
+            re: vec![[0.0; MAP_LANES]; n],
+            im: vec![[0.0; MAP_LANES]; n],
+            step: vec![(0.0, 0.0); n],
+            stride: vec![(0.0, 0.0); n],
+        }
+    }
+
+    /// Writes V(`from_hz` + k·step, `zeta`) into `out[k]` for every k.
+    fn fill(&mut self, from_hz: f64, zeta: f64, out: &mut [f64]) {
+        use std::f64::consts::PI;
+        let nf = out.len();
+        if nf == 0 {
+            return;
+        }
+        let damped = (1.0 - zeta * zeta).sqrt();
+        let t_n = self.t_n;
+        let d_omega = 2.0 * PI * self.step_hz;
+        for ((step, stride), &t) in self.step.iter_mut().zip(&mut self.stride).zip(&self.times) {
+            *step = term(1.0, t, t_n, d_omega, zeta, damped);
+            *stride = term(1.0, t, t_n, MAP_LANES as f64 * d_omega, zeta, damped);
+        }
+        for block in (0..nf).step_by(MAP_RESEED) {
+            let omega = 2.0 * PI * (from_hz + self.step_hz * block as f64);
+            // Seeds: the formula at the block's first frequency, stepped by Δf across the lanes.
+            for (((re, im), &(sr, si)), (&a, &t)) in self
+                .re
+                .iter_mut()
+                .zip(&mut self.im)
+                .zip(&self.step)
+                .zip(self.amplitudes.iter().zip(&self.times))
+            {
+                let (mut pr, mut pi) = term(a, t, t_n, omega, zeta, damped);
+                for l in 0..MAP_LANES {
+                    re[l] = pr;
+                    im[l] = pi;
+                    (pr, pi) = (pr * sr - pi * si, pr * si + pi * sr);
+                }
+            }
+            let end = (block + MAP_RESEED).min(nf);
+            for group in out[block..end].chunks_mut(MAP_LANES) {
+                let mut c = [0.0; MAP_LANES];
+                let mut s = [0.0; MAP_LANES];
+                for ((re, im), &(zr, zi)) in self.re.iter_mut().zip(&mut self.im).zip(&self.stride)
+                {
+                    for l in 0..MAP_LANES {
+                        c[l] += re[l];
+                        s[l] += im[l];
+                        let r = re[l] * zr - im[l] * zi;
+                        im[l] = re[l] * zi + im[l] * zr;
+                        re[l] = r;
+                    }
+                }
+                for (v, (c, s)) in group.iter_mut().zip(c.iter().zip(&s)) {
+                    *v = self.scale * (c * c + s * s).sqrt();
+                }
+            }
+        }
+    }
 }

@@ -120,6 +120,79 @@ pub fn insensitivity(shaper: JsValue, mode: JsValue, vtol: f64) -> Result<JsValu
     to_js(&band)
 }
 
+/// Sets `object[key] = value`, reporting a failure as a render error.
+fn set(object: &js_sys::Object, key: &str, value: &JsValue) -> Result<(), JsValue> {
+    js_sys::Reflect::set(object, &key.into(), value)
+        .map(|_| ())
+        .map_err(|_| {
+            js_error(Error::Render {
+                reason: format!("could not set `{key}` on the result"),
+            })
+        })
+}
+
+/// `sensitivityMap(shaper, { fromHz, toHz, frequencyPoints, dampingFrom, dampingTo,
+/// dampingPoints })` → `{ frequencyHz: number[], damping: number[], vibration: Float64Array }`:
+/// V on the frequency × damping grid, `vibration` row-major with one row per damping value
+/// (`vibration[k * frequencyHz.length + j]` is V at `damping[k]`, `frequencyHz[j]`). The grid
+/// is returned as a typed array because copying it is far cheaper than building a JS array.
+#[wasm_bindgen(js_name = sensitivityMap)]
+pub fn sensitivity_map(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+    let shaper = shaper_from_js(shaper).map_err(js_error)?;
+    let options: vibration::SensitivityMapOptions =
+        from_js(options, "options").map_err(js_error)?;
+    let map = vibration::sensitivity_map(&shaper, &options).map_err(js_error)?;
+    let out = js_sys::Object::new();
+    set(&out, "frequencyHz", &to_js(&map.frequency_hz)?)?;
+    set(&out, "damping", &to_js(&map.damping)?)?;
+    let vibration = js_sys::Float64Array::from(map.vibration.as_slice());
+    set(&out, "vibration", &vibration)?;
+    Ok(out.into())
+}
+
+/// `dampingSensitivity(shaper, { frequencyHz, fromDamping, toDamping, points })` →
+/// `{ damping: number[], vibration: number[] }`: V over damping ratios at one frequency.
+#[wasm_bindgen(js_name = dampingSensitivity)]
+pub fn damping_sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+    let shaper = shaper_from_js(shaper).map_err(js_error)?;
+    let options: vibration::DampingSensitivityOptions =
+        from_js(options, "options").map_err(js_error)?;
+    let curve = vibration::damping_sensitivity(&shaper, &options).map_err(js_error)?;
+    to_js(&curve)
+}
+
+/// `dampingInsensitivity(shaper, { frequencyHz, damping }, vtol)` →
+/// `{ lowDamping, highDamping, width }`: the band of damping ratios around the mode's where
+/// V ≤ vtol at the mode's frequency; `width = highDamping − lowDamping`.
+#[wasm_bindgen(js_name = dampingInsensitivity)]
+pub fn damping_insensitivity(
+    shaper: JsValue,
+    mode: JsValue,
+    vtol: f64,
+) -> Result<JsValue, JsValue> {
+    let shaper = shaper_from_js(shaper).map_err(js_error)?;
+    let mode = mode_from_js(mode, "mode").map_err(js_error)?;
+    let band = vibration::damping_insensitivity(&shaper, &mode, vtol).map_err(js_error)?;
+    to_js(&band)
+}
+
+/// `robustnessTable({ frequencyHz, damping }, vtol, specs?)` → `[{ spec, title, impulses,
+/// durationS, durationPeriods, insensitivity, dampingInsensitivity }]`: each family designed for
+/// the mode, its duration in periods and its insensitivities (Singhose 2009 Fig. 11).
+/// `specs` is an array of `{ family, …parameters }`; without it, every family that needs no
+/// parameters.
+#[wasm_bindgen(js_name = robustnessTable)]
+pub fn robustness_table(mode: JsValue, vtol: f64, specs: JsValue) -> Result<JsValue, JsValue> {
+    let mode = mode_from_js(mode, "mode").map_err(js_error)?;
+    let specs: Vec<ShaperSpec> = if specs.is_undefined() || specs.is_null() {
+        crate::robustness::parameterless_specs()
+    } else {
+        from_js(specs, "specs").map_err(js_error)?
+    };
+    let rows = crate::robustness::robustness_table(&specs, &mode, vtol).map_err(js_error)?;
+    to_js(&rows)
+}
+
 /// `families()` → the table of shaper families: `[{ name, title, guarantee, parameters, source }]`.
 #[wasm_bindgen]
 pub fn families() -> Result<JsValue, JsValue> {

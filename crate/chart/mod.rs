@@ -1,13 +1,17 @@
 //! Charts, each written once against plotters' [`DrawingBackend`]: the page draws them on a
 //! canvas (plotters-canvas), native tests into an SVG string they can assert on.
 
+pub mod damping;
 pub mod impulses;
+pub mod map;
 pub mod sensitivity;
 
 use crate::error::Error;
 use plotters::prelude::*;
 
+pub use damping::draw_damping_sensitivity;
 pub use impulses::draw_impulses;
+pub use map::draw_sensitivity_map;
 pub use sensitivity::draw_sensitivity;
 
 /// Colours of up to four overlaid series (colour-blind-safe Okabe–Ito hues).

@@ -1,0 +1,104 @@
+//! The damping sensitivity chart: residual vibration V (in %) against the plant's damping ratio
+//! at a fixed frequency, with the tolerable level Vtol and the modelled damping marked.
+
+use super::{render_error, ChartStyle};
+use crate::error::Result;
+use crate::vibration::DampingSensitivityCurve;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Draws damping sensitivity curves (one per labelled shaper), a horizontal line at `vtol`
+/// (fraction) and a vertical marker at each damping ratio in `modes_damping`.
+pub fn draw_damping_sensitivity<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    curves: &[(&str, &DampingSensitivityCurve)],
+    vtol: Option<f64>,
+    modes_damping: &[f64],
+    style: &ChartStyle,
+) -> Result<()> {
+    area.fill(&WHITE).map_err(render_error)?;
+    let (z_lo, z_hi) = curves
+        .iter()
+        .flat_map(|(_, c)| c.damping.iter().copied())
+        .filter(|z| z.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| {
+            (lo.min(z), hi.max(z))
+        });
+    let (z_lo, z_hi) = if z_lo < z_hi {
+        (z_lo, z_hi)
+    } else {
+        (0.0, 1.0)
+    };
+    let v_max = curves
+        .iter()
+        .flat_map(|(_, c)| c.vibration.iter().copied())
+        .filter(|v| v.is_finite())
+        .fold(vtol.unwrap_or(0.0), f64::max)
+        .max(1e-3)
+        * 100.0
+        * 1.06;
+    let mut chart = ChartBuilder::on(area)
+        .caption("Residual vibration V(ζ)", ("sans-serif", style.font(16.0)))
+        .margin(style.px(10.0))
+        .x_label_area_size(style.px(40.0))
+        .y_label_area_size(style.px(52.0))
+        .build_cartesian_2d(z_lo..z_hi, 0.0..v_max)
+        .map_err(render_error)?;
+    chart
+        .configure_mesh()
+        .x_desc("damping ratio ζ")
+        .y_desc("vibration (%)")
+        .label_style(("sans-serif", style.font(12.0)))
+        .axis_desc_style(("sans-serif", style.font(13.0)))
+        .light_line_style(RGBColor(238, 238, 238))
+        .draw()
+        .map_err(render_error)?;
+    let marker = RGBColor(120, 120, 120);
+    for &z in modes_damping.iter().filter(|z| (z_lo..=z_hi).contains(*z)) {
+        chart
+            .draw_series(LineSeries::new(
+                [(z, 0.0), (z, v_max)],
+                marker.stroke_width(style.px(1.0)),
+            ))
+            .map_err(render_error)?;
+    }
+    if let Some(vtol) = vtol {
+        let red = RGBColor(200, 30, 30);
+        chart
+            .draw_series(LineSeries::new(
+                [(z_lo, vtol * 100.0), (z_hi, vtol * 100.0)],
+                red.stroke_width(style.px(1.0)),
+            ))
+            .map_err(render_error)?
+            .label(format!("Vtol {:.3} %", vtol * 100.0))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], red.stroke_width(2)));
+    }
+    for (k, (label, curve)) in curves.iter().enumerate() {
+        let color = style.color(k);
+        chart
+            .draw_series(LineSeries::new(
+                curve
+                    .damping
+                    .iter()
+                    .zip(&curve.vibration)
+                    .filter(|(z, v)| z.is_finite() && v.is_finite())
+                    .map(|(&z, &v)| (z, v * 100.0)),
+                color.stroke_width(style.px(2.0)),
+            ))
+            .map_err(render_error)?
+            .label(label.to_string())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(3))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .label_font(("sans-serif", style.font(12.0)))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(180, 180, 180))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(render_error)?;
+    area.present().map_err(render_error)?;
+    Ok(())
+}

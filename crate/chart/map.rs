@@ -1,0 +1,293 @@
+//! The sensitivity map: residual vibration V over frequency × damping as a heat map, with the
+//! contour V = Vtol drawn over it and the modes marked (Singhose 2009 Fig. 10, seen from above).
+//!
+//! Cells are coloured on a viridis-like scale quantised to [`COLOR_LEVELS`] steps; equal
+//! neighbours in a row are merged into one rectangle, so a 400 × 200 map draws a few thousand
+//! rectangles rather than 80 000. The contour is traced by marching squares on the grid
+//! ([`contour_segments`]).
+
+use super::{render_error, ChartStyle};
+use crate::error::{Error, Result};
+use crate::vibration::SensitivityMap;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Number of distinct colours of the heat map.
+pub const COLOR_LEVELS: usize = 64;
+
+/// Anchors of the colour scale (matplotlib's viridis at 0, ⅛, …, 1), dark = little vibration.
+const VIRIDIS: [(u8, u8, u8); 9] = [
+    (68, 1, 84),
+    (71, 44, 122),
+    (59, 81, 139),
+    (44, 113, 142),
+    (33, 144, 141),
+    (39, 173, 129),
+    (92, 200, 99),
+    (170, 220, 50),
+    (253, 231, 37),
+];
+
+/// Colour of the V = Vtol contour and of the mode markers.
+const CONTOUR_COLOR: RGBColor = RGBColor(255, 255, 255);
+
+/// The colour of `x` ∈ [0, 1] on the scale (clamped; NaN is the bottom colour).
+pub fn scale_color(x: f64) -> RGBColor {
+    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    let pos = x * (VIRIDIS.len() - 1) as f64;
+    let i = (pos.floor() as usize).min(VIRIDIS.len() - 2);
+    let t = pos - i as f64;
+    let (a, b) = (VIRIDIS[i], VIRIDIS[i + 1]);
+    let mix = |p: u8, q: u8| (f64::from(p) + t * (f64::from(q) - f64::from(p))).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// The colour level (0 … [`COLOR_LEVELS`] − 1) of vibration `v` on a scale topped at `top`.
+fn level(v: f64, top: f64) -> usize {
+    let x = if v.is_finite() { v / top } else { 1.0 };
+    ((x.clamp(0.0, 1.0) * COLOR_LEVELS as f64) as usize).min(COLOR_LEVELS - 1)
+}
+
+/// Colour of a level (its midpoint on the scale).
+fn level_color(level: usize) -> RGBColor {
+    scale_color((level as f64 + 0.5) / COLOR_LEVELS as f64)
+}
+
+/// The contour V = `level` of a map as line segments ((f₁ Hz, ζ₁), (f₂ Hz, ζ₂)), by marching
+/// squares: on each grid cell the crossing points on its edges are found by linear
+/// interpolation and joined; a saddle cell (four crossings) is resolved by the mean of its
+/// corners. Empty if the map's vectors are inconsistent.
+pub fn contour_segments(map: &SensitivityMap, level: f64) -> Vec<[(f64, f64); 2]> {
+    let (f, z) = (&map.frequency_hz, &map.damping);
+    let mut segments = Vec::new();
+    if map.vibration.len() != f.len() * z.len() {
+        return segments;
+    }
+    let at = |k: usize, j: usize| map.vibration.get(k * f.len() + j).copied();
+    for k in 0..z.len().saturating_sub(1) {
+        for j in 0..f.len().saturating_sub(1) {
+            // Corners counter-clockwise from bottom-left: (f, ζ, V).
+            let corners = [(j, k), (j + 1, k), (j + 1, k + 1), (j, k + 1)].map(|(j, k)| {
+                (
+                    f.get(j).copied().unwrap_or(0.0),
+                    z.get(k).copied().unwrap_or(0.0),
+                    at(k, j).unwrap_or(f64::NAN),
+                )
+            });
+            if corners.iter().any(|c| !c.2.is_finite()) {
+                continue;
+            }
+            // Crossing on edge e (from corner e to corner e+1), if the level separates them.
+            let crossing = |e: usize| {
+                let (p, q) = (corners[e], corners[(e + 1) % 4]);
+                if (p.2 > level) == (q.2 > level) {
+                    return None;
+                }
+                let t = (level - p.2) / (q.2 - p.2);
+                Some((p.0 + t * (q.0 - p.0), p.1 + t * (q.1 - p.1)))
+            };
+            let cuts: Vec<(usize, (f64, f64))> =
+                (0..4).filter_map(|e| crossing(e).map(|c| (e, c))).collect();
+            match cuts.as_slice() {
+                [(_, a), (_, b)] => segments.push([*a, *b]),
+                [(_, bottom), (_, right), (_, top), (_, left)] => {
+                    let mean = corners.iter().map(|c| c.2).sum::<f64>() / 4.0;
+                    if (mean > level) == (corners[0].2 > level) {
+                        // The bottom-left and top-right corners connect through the centre:
+                        // cut off the other two.
+                        segments.push([*bottom, *right]);
+                        segments.push([*top, *left]);
+                    } else {
+                        segments.push([*bottom, *left]);
+                        segments.push([*right, *top]);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    segments
+}
+
+/// Checks that a map is drawable: at least 2 × 2 points, increasing axes, as many values as
+/// grid points.
+fn check_map(map: &SensitivityMap) -> Result<()> {
+    let (nf, nz) = (map.frequency_hz.len(), map.damping.len());
+    if nf < 2 || nz < 2 {
+        return Err(Error::invalid(
+            "map",
+            format!("needs at least 2 frequencies and 2 damping ratios, got {nf} × {nz}"),
+        ));
+    }
+    if map.vibration.len() != nf * nz {
+        return Err(Error::invalid(
+            "map.vibration",
+            format!(
+                "needs frequencyHz.length × damping.length = {} values, got {}",
+                nf * nz,
+                map.vibration.len()
+            ),
+        ));
+    }
+    let increasing =
+        |v: &[f64]| v.windows(2).all(|w| w[0] < w[1]) && v.iter().all(|x| x.is_finite());
+    if !increasing(&map.frequency_hz) {
+        return Err(Error::invalid(
+            "map.frequencyHz",
+            "must be finite and increasing",
+        ));
+    }
+    if !increasing(&map.damping) {
+        return Err(Error::invalid(
+            "map.damping",
+            "must be finite and increasing",
+        ));
+    }
+    Ok(())
+}
+
+/// Cell edges along an axis: midpoints between grid values, the ends at the first and last.
+fn cell_edges(values: &[f64]) -> Vec<f64> {
+    let mut edges = Vec::with_capacity(values.len() + 1);
+    edges.extend(values.first());
+    edges.extend(values.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+    edges.extend(values.last());
+    edges
+}
+
+/// Draws the heat map of `map` (x: frequency in Hz, y: damping ratio), the contour V = `vtol`
+/// (fraction) in white, a white cross at each mode `(frequency Hz, damping)` in `modes`, and a
+/// colour bar of V in % on the right. The colour scale runs from 0 to the largest V of the map
+/// (at least `vtol`).
+pub fn draw_sensitivity_map<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    map: &SensitivityMap,
+    vtol: Option<f64>,
+    modes: &[(f64, f64)],
+    style: &ChartStyle,
+) -> Result<()> {
+    check_map(map)?;
+    area.fill(&WHITE).map_err(render_error)?;
+    let top = map
+        .vibration
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(vtol.unwrap_or(0.0), f64::max)
+        .max(1e-3);
+    let (width, _) = area.dim_in_pixel();
+    let bar_width = style.px(78.0).min(width / 3);
+    let (main, bar) = area.split_horizontally(width.saturating_sub(bar_width).max(1));
+
+    let (f, z) = (&map.frequency_hz, &map.damping);
+    let (f_lo, f_hi, z_lo, z_hi) = (f[0], f[f.len() - 1], z[0], z[z.len() - 1]);
+    let mut chart = ChartBuilder::on(&main)
+        .caption(
+            "Residual vibration V(f, ζ)",
+            ("sans-serif", style.font(16.0)),
+        )
+        .margin(style.px(10.0))
+        .x_label_area_size(style.px(40.0))
+        .y_label_area_size(style.px(52.0))
+        .build_cartesian_2d(f_lo..f_hi, z_lo..z_hi)
+        .map_err(render_error)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("frequency (Hz)")
+        .y_desc("damping ratio ζ")
+        .label_style(("sans-serif", style.font(12.0)))
+        .axis_desc_style(("sans-serif", style.font(13.0)))
+        .draw()
+        .map_err(render_error)?;
+
+    // Cells, with runs of equal colour along a row merged into one rectangle.
+    let (fe, ze) = (cell_edges(f), cell_edges(z));
+    let mut cells = Vec::new();
+    for (k, row) in map.vibration.chunks_exact(f.len()).enumerate() {
+        let (y0, y1) = (ze[k], ze[k + 1]);
+        let mut start = 0;
+        while start < row.len() {
+            let lv = level(row[start], top);
+            let mut end = start + 1;
+            while end < row.len() && level(row[end], top) == lv {
+                end += 1;
+            }
+            cells.push(Rectangle::new(
+                [(fe[start], y0), (fe[end], y1)],
+                level_color(lv).filled(),
+            ));
+            start = end;
+        }
+    }
+    chart.draw_series(cells).map_err(render_error)?;
+
+    if let Some(vtol) = vtol {
+        let line = CONTOUR_COLOR.stroke_width(style.px(2.0));
+        chart
+            .draw_series(
+                contour_segments(map, vtol)
+                    .into_iter()
+                    .map(|[a, b]| PathElement::new(vec![a, b], line)),
+            )
+            .map_err(render_error)?
+            .label(format!("V = Vtol ({:.3} %)", vtol * 100.0))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], line));
+    }
+    let inside =
+        |&&(mf, mz): &&(f64, f64)| (f_lo..=f_hi).contains(&mf) && (z_lo..=z_hi).contains(&mz);
+    let size = style.px(6.0) as i32;
+    chart
+        .draw_series(
+            modes.iter().filter(inside).map(|&(mf, mz)| {
+                Cross::new((mf, mz), size, CONTOUR_COLOR.stroke_width(style.px(2.0)))
+            }),
+        )
+        .map_err(render_error)?;
+    if vtol.is_some() {
+        chart
+            .configure_series_labels()
+            .label_font(("sans-serif", style.font(12.0)))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(180, 180, 180))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(render_error)?;
+    }
+
+    // Colour bar: the levels stacked from 0 to `top`, labelled in %.
+    let top_pct = top * 100.0;
+    let mut bar_chart = ChartBuilder::on(&bar)
+        .margin_top(style.px(36.0))
+        .margin_bottom(style.px(50.0))
+        .margin_right(style.px(4.0))
+        .y_label_area_size(style.px(48.0))
+        .build_cartesian_2d(0.0..1.0, 0.0..top_pct)
+        .map_err(render_error)?;
+    bar_chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc("V (%)")
+        .label_style(("sans-serif", style.font(11.0)))
+        .axis_desc_style(("sans-serif", style.font(12.0)))
+        .draw()
+        .map_err(render_error)?;
+    bar_chart
+        .draw_series((0..COLOR_LEVELS).map(|lv| {
+            let y0 = top_pct * lv as f64 / COLOR_LEVELS as f64;
+            let y1 = top_pct * (lv + 1) as f64 / COLOR_LEVELS as f64;
+            Rectangle::new([(0.0, y0), (1.0, y1)], level_color(lv).filled())
+        }))
+        .map_err(render_error)?;
+    if let Some(vtol) = vtol {
+        bar_chart
+            .draw_series(LineSeries::new(
+                [(0.0, vtol * 100.0), (1.0, vtol * 100.0)],
+                CONTOUR_COLOR.stroke_width(style.px(2.0)),
+            ))
+            .map_err(render_error)?;
+    }
+    area.present().map_err(render_error)?;
+    Ok(())
+}

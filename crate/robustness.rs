@@ -1,0 +1,87 @@
+//! Robustness against duration, family by family (Singhose 2009 Fig. 11).
+//!
+//! A robust shaper buys insensitivity to modelling errors with duration: ZV lasts half a period
+//! and keeps V ≤ 5 % over a 6 % band of frequencies, ZVD lasts a period and covers 29 %, and so
+//! on (Singhose 2009 §3.1, Figs. 7 and 11). [`robustness_table`] designs each requested family
+//! for one mode and lists its duration in periods next to its insensitivities, so families —
+//! including ones added later — can be compared on the same axes as Fig. 11.
+
+use crate::design::{design_for, ShaperSpec, FAMILIES};
+use crate::error::{count, Error, Result};
+use crate::mode::Mode;
+use crate::vibration::{damping_insensitivity, insensitivity, tolerable_vibration};
+use serde::de::value::{Error as ValueError, MapDeserializer};
+use serde::{Deserialize, Serialize};
+
+/// Most rows (specs) one table may have.
+pub const MAX_TABLE_ROWS: usize = 64;
+
+/// One family's point on the robustness–duration chart.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct RobustnessRow {
+    /// The spec the shaper was designed from (family and parameters).
+    pub spec: ShaperSpec,
+    /// The family's human name (from [`FAMILIES`]).
+    pub title: String,
+    /// Number of impulses.
+    pub impulses: usize,
+    /// Duration (time of the last impulse) in seconds.
+    pub duration_s: f64,
+    /// Duration in damped periods of the mode, T_d = 2π/ω_d (the horizontal axis of Singhose
+    /// 2009 Fig. 11; at ζ = 0 the same as undamped periods).
+    pub duration_periods: f64,
+    /// Frequency insensitivity I(Vtol): the width of the band around the mode where V ≤ Vtol,
+    /// as a fraction of the mode's frequency (the vertical axis of Fig. 11; see
+    /// [`crate::vibration::insensitivity`]).
+    pub insensitivity: f64,
+    /// Width of the damping band around the mode's damping where V ≤ Vtol at the mode's
+    /// frequency, in damping ratio (see [`crate::vibration::damping_insensitivity`]).
+    pub damping_insensitivity: f64,
+}
+
+/// Every family of [`FAMILIES`] that can be designed from its name alone (a spec
+/// `{ family }` with no other field parses), in the table's order. Families with required
+/// parameters (such as `zvdn`'s `derivatives`) are left out; pass them explicitly to
+/// [`robustness_table`].
+pub fn parameterless_specs() -> Vec<ShaperSpec> {
+    FAMILIES
+        .iter()
+        .filter_map(|family| {
+            let fields = std::iter::once(("family", family.name));
+            ShaperSpec::deserialize(MapDeserializer::<_, ValueError>::new(fields)).ok()
+        })
+        .collect()
+}
+
+/// Designs each of `specs` for `mode` and measures it: duration in periods, frequency
+/// insensitivity I(`vtol`) and damping insensitivity (Singhose 2009 Fig. 11 as a table).
+///
+/// Errors: `vtol` outside (0, 1); more than [`MAX_TABLE_ROWS`] specs; a spec that cannot be
+/// designed for the mode (the error is prefixed `specs[i]`).
+pub fn robustness_table(
+    specs: &[ShaperSpec],
+    mode: &Mode,
+    vtol: f64,
+) -> Result<Vec<RobustnessRow>> {
+    tolerable_vibration(vtol)?;
+    count("specs", specs.len(), 0, MAX_TABLE_ROWS)?;
+    let period = mode.damped_period_s();
+    specs
+        .iter()
+        .enumerate()
+        .map(|(i, spec)| {
+            let within = |e: Error| e.within(&format!("specs[{i}]"));
+            let shaper = design_for(spec, std::slice::from_ref(mode)).map_err(within)?;
+            Ok(RobustnessRow {
+                spec: spec.clone(),
+                title: spec.info().map_or(spec.name(), |f| f.title).to_string(),
+                impulses: shaper.len(),
+                duration_s: shaper.duration(),
+                duration_periods: shaper.duration() / period,
+                insensitivity: insensitivity(&shaper, mode, vtol)?.width,
+                damping_insensitivity: damping_insensitivity(&shaper, mode, vtol)?.width,
+            })
+        })
+        .collect()
+}
