@@ -256,7 +256,9 @@ struct ShaperResult {
     insensitivity: Vec<vibration::Insensitivity>,
     residual_at_modes: Vec<f64>,
     centroid_delay: Option<f64>,
-    klipper: crate::smoothing::KlipperFigures,
+    /// `None` (JS `null`) for shapers whose amplitudes sum to zero (bang-bang, on/off):
+    /// Klipper's smoothing divides by that sum.
+    klipper: Option<crate::smoothing::KlipperFigures>,
 }
 
 #[derive(Serialize)]
@@ -348,8 +350,13 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
             .map(|m| vibration::insensitivity(&shaper, m, view.vtol))
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| js_error(e.within("view")))?;
-        let klipper = crate::smoothing::klipper_figures(&shaper, view.scv)
-            .map_err(|e| js_error(e.within("view")))?;
+        let klipper = match shaper.centroid_delay() {
+            Some(_) => Some(
+                crate::smoothing::klipper_figures(&shaper, view.scv)
+                    .map_err(|e| js_error(e.within("view")))?,
+            ),
+            None => None,
+        };
         results.push(ShaperResult {
             label: labels[k].clone(),
             family: spec.name(),

@@ -52,7 +52,8 @@ layer native cargo test
 layer wasm-node wasm-pack test --node
 layer wasm-browser wasm-pack test --headless --chrome
 layer build bash scripts/build.sh
-layer e2e node --test --test-reporter=tap tests/e2e/
+# A test that hangs (a page stuck in a loop) fails after 5 minutes instead of stalling CI.
+layer e2e node --test --test-timeout=300000 --test-reporter=tap tests/e2e/
 
 echo
 echo "$passed passed, $failed failed"

@@ -104,3 +104,30 @@ fn missing_canvases_are_skipped() {
     let result = wasm::render_playground(state, JsValue::from(js_sys::Object::new())).unwrap();
     assert!(Reflect::get(&result, &"shaper".into()).unwrap().is_object());
 }
+
+/// Bang-bang and on/off amplitudes sum to zero: Klipper's smoothing (which divides by that
+/// sum) is `null` for them, and the frame is still drawn — it used to fail the whole frame.
+#[wasm_bindgen_test]
+fn zero_sum_shapers_render_with_null_klipper_figures() {
+    let (imp, sens) = (canvas(640, 360), canvas(640, 360));
+    let canvases = js_sys::Object::new();
+    Reflect::set(&canvases, &"impulses".into(), &imp).unwrap();
+    Reflect::set(&canvases, &"sensitivity".into(), &sens).unwrap();
+    let state = JSON::parse(
+        r#"{"modes":[{"frequencyHz":2,"damping":0.05}],
+            "shapers":[{"family":"bangbang","distance":1,"maxAcceleration":10},
+                       {"family":"onoff","distance":1,"maxAcceleration":10,"coastTime":0.5},
+                       {"family":"zv"}]}"#,
+    )
+    .unwrap();
+    let result = wasm::render_playground(state, canvases.into()).unwrap();
+    let results: js_sys::Array = Reflect::get(&result, &"results".into())
+        .unwrap()
+        .dyn_into()
+        .unwrap();
+    let klipper = |k: u32| Reflect::get(&results.get(k), &"klipper".into()).unwrap();
+    assert!(klipper(0).is_null(), "bang-bang: no Klipper figures");
+    assert!(klipper(1).is_null(), "on/off: no Klipper figures");
+    assert!(klipper(2).is_object(), "ZV has them");
+    assert!(series_pixels(&pixels(&imp)) > 50, "impulses drawn");
+}

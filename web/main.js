@@ -167,7 +167,9 @@ function showError(error) {
       group.querySelector('.group-error, .error').textContent = message;
       return;
     }
-    path = path.replace(/(\.[^.[\]]*|\[\d+\])$/, '');
+    const parent = path.replace(/(\.[^.[\]]*|\[\d+\])$/, '');
+    // A top-level name ("view") has no parent: stop rather than loop on it.
+    path = parent === path ? '' : parent;
   }
   $('general-error').textContent = message;
 }
@@ -192,8 +194,8 @@ function showResults(result, st) {
     rows.push([`Band with V ≤ ${vtolPct} %${tag} (Hz)`, (r) => `${fmt(r.insensitivity[i].lowHz, 5)} – ${fmt(r.insensitivity[i].highHz, 5)}`]);
     rows.push([`Residual vibration${tag} (%)`, (r) => fmtPct(r.residualAtModes[i])]);
   });
-  rows.push(['Klipper smoothing at 5000 mm/s² (mm)', (r) => fmt(r.klipper.smoothing, 4)]);
-  rows.push(['Klipper max accel (mm/s²)', (r) => (r.klipper.maxAccel == null ? '∞' : fmt(r.klipper.maxAccel, 5))]);
+  rows.push(['Klipper smoothing at 5000 mm/s² (mm)', (r) => (r.klipper == null ? 'n/a (Σ amplitudes = 0)' : fmt(r.klipper.smoothing, 4))]);
+  rows.push(['Klipper max accel (mm/s²)', (r) => (r.klipper == null ? 'n/a' : r.klipper.maxAccel == null ? '∞' : fmt(r.klipper.maxAccel, 5))]);
   $('summary').tBodies[0].replaceChildren(...rows.map(([name, f]) => el('tr', {},
     el('th', { scope: 'row' }, name), ...results.map((r) => el('td', {}, f(r))))));
 
