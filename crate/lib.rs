@@ -18,6 +18,8 @@
 //! - [`shaper`]: the impulse sequence, convolution, duration, centroid delay.
 //! - [`vibration`]: V(ω, ζ) (Singhose 2009 eq. 11), sensitivity curves, insensitivity bands.
 //! - [`design`]: the spec, the table of families, and one file per family of the literature.
+//! - [`solve`]: the shortest shaper under vibration constraints (convex program on a time grid,
+//!   bisection on the duration, Newton polish, dense checks) shared by the solved families.
 //! - [`chart`]: charts drawn with plotters on any backend (canvas in the page, SVG in tests).
 //! - [`error`]: the one error type; nothing reachable from the public API panics.
 //! - `wasm` (wasm32 only): the JavaScript API (`design`, `residualVibration`, `sensitivity`, …).
@@ -27,6 +29,7 @@ pub mod design;
 pub mod error;
 pub mod mode;
 pub mod shaper;
+pub mod solve;
 pub mod vibration;
 
 #[cfg(target_arch = "wasm32")]
