@@ -737,7 +737,10 @@ fn polish_from(
     }
 
     for _ in 0..MAX_ACTIVE_SET_ROUNDS {
-        if active.impulses.len() < 2 || freedom(norm, &active) < 0 {
+        // (More equations than unknowns is allowed: degenerate but consistent systems, e.g.
+        // a single-mode ZVD that also cancels a mode at an odd multiple of its frequency, are
+        // solved by Gauss–Newton in the least-squares sense; inconsistent ones fail there.)
+        if active.impulses.len() < 2 {
             return None;
         }
         let (setup, y0) = build(norm, &active);
