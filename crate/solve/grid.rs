@@ -171,6 +171,11 @@ pub(crate) fn solve_on_times(
         verbose: false,
         max_iter: MAX_SOLVER_ITERATIONS,
         presolve_enable: false,
+        // The duration search needs the level to ~1e-6; the polish makes the result exact.
+        tol_gap_abs: 1e-7,
+        tol_gap_rel: 1e-7,
+        tol_feas: 1e-7,
+        iterative_refinement_max_iter: 3,
         ..DefaultSettings::default()
     };
     let Ok(mut solver) = DefaultSolver::new(&p, &q, &a, &b, &cones, settings) else {

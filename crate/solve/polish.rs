@@ -27,7 +27,11 @@ const MAX_SPLITS: usize = 2;
 /// Newton/SQP iterations per active set.
 const MAX_NEWTON_ITERATIONS: usize = 60;
 /// Active-set changes tried.
-const MAX_ACTIVE_SET_ROUNDS: usize = 12;
+const MAX_ACTIVE_SET_ROUNDS: usize = 16;
+/// Active points left out in turn when the active set is inconsistent.
+const MAX_DROPS: usize = 4;
+/// Gauss–Newton gives up when ‖c‖ has not halved in this many iterations.
+const STALL_ITERATIONS: usize = 6;
 /// Candidates within this of the highest V/Vtol on the grid solution start out active.
 const ACTIVE_BAND: f64 = 0.05;
 /// Converged when every residual is below this.
@@ -347,12 +351,21 @@ fn sqp(setup: &Setup, y0: Vec<f64>) -> Option<Solved> {
         return None;
     }
     let infeasibility = |c: &[f64]| c.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+    let (mut best_c, mut since_best) = (f64::INFINITY, 0);
     for _ in 0..MAX_NEWTON_ITERATIONS {
         let c = DVector::from_vec(setup.residuals(&y));
         let lin = Linearization::new(setup.jacobian(&y), &grad_f)?;
         let gz: Vec<f64> = lin.null.iter().map(|z| z.dot(&grad_f)).collect();
         let c_max = c.amax();
         let gz_max = gz.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        if c_max < 0.5 * best_c {
+            (best_c, since_best) = (c_max, 0);
+        } else if c_max > RESTORATION_THRESHOLD {
+            since_best += 1;
+            if since_best >= STALL_ITERATIONS {
+                return None; // an inconsistent system: Gauss–Newton is stuck in least squares
+            }
+        }
         if c_max <= RESIDUAL_TOLERANCE && gz_max <= GRADIENT_TOLERANCE {
             return Some(Solved {
                 y,
@@ -444,15 +457,14 @@ fn sqp(setup: &Setup, y0: Vec<f64>) -> Option<Solved> {
             null_step *= MAX_NULL_STEP / big;
         }
 
-        let mut accepted = None;
-        let mut alpha = 1.0;
-        for _ in 0..30 {
+        // A trial point: the Gauss–Newton step plus α times the null-space step, pulled back
+        // onto c = 0 with the current Jacobian (chord iterations).
+        let trial_at = |alpha: f64| -> Option<Vec<f64>> {
             let dy = &dy_range + &null_step * alpha;
             let mut trial = step_to(&dy, 1.0);
-            // Back onto c = 0 with the current Jacobian (chord iterations).
             for _ in 0..4 {
                 if !setup.valid(&trial) {
-                    break;
+                    return None;
                 }
                 let ct = DVector::from_vec(setup.residuals(&trial));
                 if ct.amax() <= RESIDUAL_TOLERANCE {
@@ -463,16 +475,29 @@ fn sqp(setup: &Setup, y0: Vec<f64>) -> Option<Solved> {
                     *t += d;
                 }
             }
-            if setup.valid(&trial) {
-                let ct = infeasibility(&setup.residuals(&trial));
-                if ct <= c_max.max(RESIDUAL_TOLERANCE) && trial[di] < y[di] {
+            let ok = setup.valid(&trial)
+                && infeasibility(&setup.residuals(&trial)) <= c_max.max(RESIDUAL_TOLERANCE);
+            ok.then_some(trial)
+        };
+        // The restored point without the null-space step is the baseline the step must beat:
+        // making c = 0 exact may itself cost some duration.
+        let base = trial_at(0.0);
+        let mut accepted = None;
+        let mut alpha = 1.0;
+        for _ in 0..30 {
+            if let Some(trial) = trial_at(alpha) {
+                let beats = match &base {
+                    Some(b) => trial[di] < b[di],
+                    None => trial[di] < y[di],
+                };
+                if beats {
                     accepted = Some(trial);
                     break;
                 }
             }
             alpha *= 0.5;
         }
-        match accepted {
+        match accepted.or(base.filter(|_| c_max > RESIDUAL_TOLERANCE)) {
             Some(t) => y = t,
             None => {
                 // No decrease found: converged as far as rounding allows, or stuck.
@@ -736,6 +761,8 @@ fn polish_from(
         }
     }
 
+    let mut dropped_from: Option<Vec<PointSpec>> = None;
+    let mut drops = 0;
     for _ in 0..MAX_ACTIVE_SET_ROUNDS {
         // (More equations than unknowns is allowed: degenerate but consistent systems, e.g.
         // a single-mode ZVD that also cancels a mode at an odd multiple of its frequency, are
@@ -756,10 +783,46 @@ fn polish_from(
                     active.points.push(*c);
                     continue;
                 }
+                _ => {}
+            }
+            // Too many (inconsistent) constraints: leave one of them out, in turn, starting
+            // from the one the grid solution held furthest below Vtol.
+            let base = dropped_from.get_or_insert_with(|| active.points.clone());
+            let mut order: Vec<usize> = (0..base.len()).collect();
+            order.sort_by(|&a, &b| base[a].grid_ratio.total_cmp(&base[b].grid_ratio));
+            match order.get(drops) {
+                Some(&k) if drops < MAX_DROPS => {
+                    let mut points = base.clone();
+                    points.remove(k);
+                    active.points = points;
+                    drops += 1;
+                    continue;
+                }
                 _ => return None,
             }
         };
         let imps = setup.impulses(&solved.y);
+
+        // Two impulses that converged onto one time are one impulse: merge and solve again.
+        let t_n = imps.last().map_or(0.0, |i| i.time);
+        if let Some(k) = (1..imps.len()).find(|&k| imps[k].time - imps[k - 1].time < 1e-7 * t_n) {
+            let mut merged = imps.clone();
+            let (a, b) = (merged[k - 1], merged[k]);
+            let sum = a.amplitude + b.amplitude;
+            merged[k - 1] = Impulse {
+                time: if sum != 0.0 {
+                    (a.time * a.amplitude + b.time * b.amplitude) / sum
+                } else {
+                    a.time
+                },
+                amplitude: sum,
+            };
+            merged.remove(k);
+            active.impulses = merged;
+            active.bounds = shift_bounds(&active.bounds, k);
+            update_points(&mut active, &setup, &solved.y);
+            continue;
+        }
 
         // Amplitudes out of bounds: drop an impulse that wants to vanish (lower bound 0),
         // otherwise pin it to the bound.
