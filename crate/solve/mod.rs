@@ -57,6 +57,9 @@ pub const CHECK_TOLERANCE: f64 = 1e-9;
 /// Largest zero-vibration moment (scaled by t_nᵏ) accepted as zero.
 pub const ZERO_TOLERANCE: f64 = 1e-9;
 
+/// Most points a Vtol profile may have.
+pub const MAX_PROFILE_POINTS: usize = 1000;
+
 /// A tolerable-vibration level that may vary with frequency: piecewise linear through
 /// `(frequency in Hz, Vtol)` points, constant beyond the first and last.
 #[derive(Debug, Clone, PartialEq)]
@@ -76,6 +79,7 @@ impl Tolerance {
         if points.is_empty() {
             return Err(Error::invalid("vtolProfile", "give at least one point"));
         }
+        crate::error::count("vtolProfile", points.len(), 1, MAX_PROFILE_POINTS)?;
         for (i, &(f, v)) in points.iter().enumerate() {
             finite(&format!("vtolProfile[{i}][0]"), f)?;
             finite(&format!("vtolProfile[{i}][1]"), v)?;
@@ -768,7 +772,7 @@ pub(crate) fn clusters(grid: &GridSolution) -> Vec<Cluster> {
         }
         if sum.abs() > 1e-4 * max {
             let mean = moment / sum;
-            let spacing = (start.saturating_sub(1)..end.min(t.len() - 1))
+            let spacing = (start.saturating_sub(1)..end.min(t.len().saturating_sub(1)))
                 .map(|i| t[i + 1] - t[i])
                 .fold(f64::INFINITY, f64::min);
             out.push(Cluster {

@@ -273,6 +273,8 @@ struct Solved {
 /// The linear algebra of one iterate: the pseudo-inverse of the Jacobian, a basis of its null
 /// space, and the least-squares multipliers.
 struct Linearization {
+    /// Number of unknowns.
+    n: usize,
     /// Rows of Vᵀ and columns of U over the numerical range, with the singular values.
     range: Vec<(DVector<f64>, DVector<f64>, f64)>,
     /// Orthonormal basis of the null space of J.
@@ -317,6 +319,7 @@ impl Linearization {
             }
         }
         Some(Linearization {
+            n,
             range,
             null,
             lambda,
@@ -325,7 +328,7 @@ impl Linearization {
 
     /// The least-norm δ with J δ = −c.
     fn restore(&self, c: &DVector<f64>) -> DVector<f64> {
-        let mut dy = DVector::zeros(self.range.first().map_or(0, |r| r.0.len()));
+        let mut dy = DVector::zeros(self.n);
         for (vk, uk, s) in &self.range {
             dy -= vk * (uk.dot(c) / s);
         }
