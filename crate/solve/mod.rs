@@ -435,7 +435,18 @@ pub fn minimum_duration(problem: &Problem) -> Result<Design> {
     let mut programs = 0;
     for round in 1..=MAX_EXCHANGE_ROUNDS {
         let mut grid = shortest_on_grid(&norm, &samples, None, &mut programs)?;
-        let mut polished = polish::polish(&norm, &grid);
+        // Neighbouring grid impulses that add up beyond the amplitude bounds mean the grid is
+        // emulating impulses the bounds forbid (binding bounds, e.g. negative shapers): no
+        // few-impulse structure to polish, and finer grids only emulate more closely.
+        let beyond_bounds = clusters(&grid).iter().any(|c| {
+            c.amplitude > norm.amplitude_max * (1.0 + 1e-3)
+                || c.amplitude < norm.amplitude_min * (1.0 + 1e-3)
+        });
+        let mut polished = if beyond_bounds {
+            None
+        } else {
+            polish::polish(&norm, &grid)
+        };
         if polished.is_none() && round < MAX_EXCHANGE_ROUNDS {
             // The polish failed. If the grid solution itself exceeds a band between the samples,
             // the samples are too few to fix the structure: add its maxima and start again.
@@ -452,13 +463,7 @@ pub fn minimum_duration(problem: &Problem) -> Result<Design> {
             }
         }
         // If the polish still fails (impulses too close for the grid to resolve, a poor
-        // start), refine the grid around the impulses the solution uses and try again —
-        // unless neighbouring grid impulses add up beyond the amplitude bounds: then the grid
-        // is emulating impulses the bounds forbid, and finer grids only do so more closely.
-        let beyond_bounds = clusters(&grid).iter().any(|c| {
-            c.amplitude > norm.amplitude_max * (1.0 + 1e-3)
-                || c.amplitude < norm.amplitude_min * (1.0 + 1e-3)
-        });
+        // start), refine the grid around the impulses the solution uses and try again.
         for _ in 0..MAX_REFINEMENTS {
             if polished.is_some() || beyond_bounds {
                 break;
