@@ -5,18 +5,18 @@
 //! derivatives) at some modes, V ≤ Vtol at sampled (frequency, damping) points, and V ≤ Vtol(f)
 //! over whole bands of frequency and damping. [`minimum_duration`] then
 //!
-//! 1. **grid + bisection** ([`grid`]): for a candidate duration T it places impulses on a fine
+//! 1. **grid + bisection** (`grid.rs`): for a candidate duration T it places impulses on a fine
 //!    grid of times in [0, T] and solves a convex program for the amplitudes (linear
 //!    constraints and second-order cones, Clarabel); the shortest feasible T is found by
 //!    bisection. For a fixed grid this is the global optimum, so the result is the globally
 //!    shortest shaper up to the grid spacing, whatever its number of impulses;
 //! 2. **reduction**: neighbouring grid impulses are merged into the few impulses the solution
 //!    really uses;
-//! 3. **polish** ([`polish`]): the times and amplitudes of those impulses (and the frequencies
+//! 3. **polish** (`polish.rs`): the times and amplitudes of those impulses (and the frequencies
 //!    of the sensitivity humps that touch Vtol) are refined by Newton's method on the active
 //!    constraints with the shortest duration as objective (a reduced-Hessian SQP), so the
 //!    result is exact, not grid-limited;
-//! 4. **guarantee** ([`scan`]): the result is checked at every sampled point and on a dense
+//! 4. **guarantee** (`scan.rs`): the result is checked at every sampled point and on a dense
 //!    grid over every band (local maxima refined); where a band is exceeded the offending points
 //!    are added to the program's constraints and the design is repeated (an exchange, or
 //!    cutting-plane, loop) until the guarantee holds.
