@@ -27,6 +27,8 @@
 //! - [`plant`]: modal LTI, two-mass spring, nonlinear pendulum; [`simulate`]: their responses;
 //!   [`metrics`]: residual vibration, settling, delay, peaks; [`spectrum`]: |U(f)|.
 //! - [`robustness`]: robustness against duration across families (Singhose 2009 Fig. 11).
+//! - [`solve`]: the shortest shaper under vibration constraints (convex program on a time grid,
+//!   bisection on the duration, Newton polish, dense checks) shared by the solved families.
 //! - [`chart`]: charts drawn with plotters on any backend (canvas in the page, SVG in tests).
 //! - [`error`]: the one error type; nothing reachable from the public API panics.
 //! - `wasm` (wasm32 only): the JavaScript API (`design`, `residualVibration`, `sensitivity`, …).
@@ -44,6 +46,7 @@ pub mod robustness;
 pub mod shaper;
 pub mod simulate;
 pub mod smoothing;
+pub mod solve;
 pub mod spectrum;
 pub mod vibration;
 

@@ -43,7 +43,8 @@ pub struct RobustnessRow {
 /// Every family of [`FAMILIES`] that can be designed from its name alone (a spec
 /// `{ family }` with no other field parses), in the table's order. Families with required
 /// parameters (such as `zvdn`'s `derivatives`) are left out; pass them explicitly to
-/// [`robustness_table`].
+/// [`robustness_table`]. `si` parses without fields but cannot be designed without a band
+/// (`insensitivity`, `bandHz` or `sampleFrequenciesHz`), so it is left out too.
 pub fn parameterless_specs() -> Vec<ShaperSpec> {
     FAMILIES
         .iter()
@@ -51,6 +52,7 @@ pub fn parameterless_specs() -> Vec<ShaperSpec> {
             let fields = std::iter::once(("family", family.name));
             ShaperSpec::deserialize(MapDeserializer::<_, ValueError>::new(fields)).ok()
         })
+        .filter(|spec| !matches!(spec, ShaperSpec::Si(_)))
         .collect()
 }
 

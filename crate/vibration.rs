@@ -22,15 +22,43 @@ pub const MAX_CURVE_POINTS: usize = 100_000;
 /// The exponentials are evaluated as e^{−ζω(t_n − tᵢ)} so nothing overflows. `omega ≥ 0` and
 /// `0 ≤ zeta < 1` are the caller's to ensure; with ω = 0 the result is |Σ Aᵢ|.
 pub fn vibration_rad(impulses: &[Impulse], omega: f64, zeta: f64) -> f64 {
+    let [c, s] = vibration_moment(impulses, omega, zeta, 0);
+    c.hypot(s)
+}
+
+/// The k-th time moment of the vibration phasor of eq. 11:
+///
+/// M_k = e^{−ζω t_n} Σ Aᵢ tᵢᵏ e^{ζω tᵢ} (cos ω_d tᵢ, sin ω_d tᵢ),  so V = |M₀|.
+///
+/// With p = ζω + iω_d, the vibration sum is W(ω) = Σ Aᵢ e^{p tᵢ} and
+/// dᵏW/dωᵏ = (ζ + i√(1−ζ²))ᵏ Σ Aᵢ tᵢᵏ e^{p tᵢ}: M₀ = … = M_n = 0 is exactly "zero vibration and n
+/// zero frequency derivatives" at (ω, ζ) (Singer & Seering 1988 §2.2; Singhose 2009 eq. 16).
+/// The multi-mode direct designs impose these as linear equalities. `t_n` is the last impulse's
+/// time, as in [`vibration_rad`].
+pub fn vibration_moment(impulses: &[Impulse], omega: f64, zeta: f64, k: u32) -> [f64; 2] {
     let t_n = impulses.last().map_or(0.0, |imp| imp.time);
     let damped = (1.0 - zeta * zeta).sqrt();
     let (mut c, mut s) = (0.0, 0.0);
     for imp in impulses {
-        let (re, im) = term(imp.amplitude, imp.time, t_n, omega, zeta, damped);
+        let w = if k == 0 {
+            imp.amplitude
+        } else {
+            imp.amplitude * imp.time.powi(k as i32)
+        };
+        let (re, im) = term(w, imp.time, t_n, omega, zeta, damped);
         c += re;
         s += im;
     }
-    c.hypot(s)
+    [c, s]
+}
+
+/// The contribution of a unit impulse at `time` to the vibration phasor of eq. 11 when the last
+/// impulse of the sequence is at `t_n`: e^{−ζω(t_n − t)} (cos ω_d t, sin ω_d t). V is the length
+/// of Σ Aᵢ · phasor(tᵢ), so once the times are fixed V is the norm of a vector linear in the
+/// amplitudes (what the convex design programs of [`crate::solve`] use).
+pub fn impulse_phasor(time: f64, t_n: f64, omega: f64, zeta: f64) -> [f64; 2] {
+    let (c, s) = term(1.0, time, t_n, omega, zeta, (1.0 - zeta * zeta).sqrt());
+    [c, s]
 }
 
 /// One impulse's contribution to eq. 11, already multiplied by the factor e^{−ζω t_n}:

@@ -8,8 +8,10 @@
 //! (Singer & Seering 1988 §2.3). Every design is checked against its guarantee with an
 //! independent evaluation of V before it is returned.
 
+pub mod direct;
 pub mod quantize;
 pub mod sampled;
+pub mod specified;
 pub mod zero_vibration;
 
 pub mod custom;
@@ -114,6 +116,12 @@ pub enum ShaperSpec {
         #[serde(default)]
         normalize: bool,
     },
+    /// Specified insensitivity: the shortest shaper with V ≤ Vtol over a band of frequencies
+    /// (and dampings), sampled or guaranteed on the whole band (Singhose 2009 eq. 18).
+    Si(specified::SiSpec),
+    /// Several modes at once: the shortest shaper with zero vibration (and derivatives) at every
+    /// mode, designed directly instead of by convolution (Singer & Seering 1988 §2.3).
+    Direct(direct::DirectSpec),
 }
 
 fn default_vtol() -> f64 {
@@ -140,6 +148,8 @@ impl ShaperSpec {
             ShaperSpec::Bangbang { .. } => "bangbang",
             ShaperSpec::Onoff { .. } => "onoff",
             ShaperSpec::Custom { .. } => "custom",
+            ShaperSpec::Si(_) => "si",
+            ShaperSpec::Direct(_) => "direct",
         }
     }
 
@@ -303,6 +313,32 @@ pub const FAMILIES: &[FamilyInfo] = &[
         parameters: &["impulses", "normalize"],
         source: "your own",
     },
+    FamilyInfo {
+        name: "si",
+        title: "SI (specified insensitivity)",
+        guarantee: "V ≤ vtol over the band (whole band, verified densely) or at the sampled \
+                    frequencies; shortest such shaper",
+        parameters: &[
+            "vtol",
+            "insensitivity",
+            "bandHz",
+            "dampingRange",
+            "sampleFrequenciesHz",
+            "vtolProfile",
+            "amplitudeMin",
+            "amplitudeMax",
+            "maxImpulses",
+            "maxDuration",
+        ],
+        source: "Singhose 2009 eq. 18, Figs. 8-11; Pelaez & Singhose 2002 eqs. 6-7",
+    },
+    FamilyInfo {
+        name: "direct",
+        title: "Direct multi-mode ZV / ZVD",
+        guarantee: "V = 0 and n derivatives zero at every mode at once; shortest such shaper",
+        parameters: &["derivatives", "amplitudeMin", "amplitudeMax", "maxDuration"],
+        source: "Singer & Seering 1988 §2.3; Singhose 2009 §4, Fig. 12",
+    },
 ];
 
 /// What a designed shaper promises, checked by [`verify`] before it is returned.
@@ -332,6 +368,20 @@ pub(crate) enum Guarantee {
     },
     /// Nothing beyond a valid impulse sequence (e.g. a user's custom shaper).
     Valid,
+    /// V ≤ Vtol·(1 + `tolerance`) at every listed (frequency in Hz, damping ratio, Vtol) point
+    /// (each point its own Vtol, for frequency-weighted designs).
+    WithinTolerance {
+        /// Points where the bound must hold.
+        points: Vec<(f64, f64, f64)>,
+        /// Allowed relative excess over each Vtol (rounding and solver tolerance).
+        tolerance: f64,
+    },
+    /// V = 0 and its first `derivatives` frequency derivatives zero at every mode (the moments
+    /// M₀ … M_n of [`crate::vibration::vibration_moment`], scaled by t_nᵏ, vanish).
+    ZeroDerivativesAtModes {
+        /// Number of zero derivatives.
+        derivatives: u32,
+    },
 }
 
 /// Largest V accepted as "zero" when checking a zero-vibration guarantee.
@@ -422,6 +472,8 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
                 ]),
             )
         }
+        ShaperSpec::Si(si) => specified::si(si, modes)?,
+        ShaperSpec::Direct(d) => direct::direct(d, modes)?,
     };
     verify(&shaper, modes, &guarantee)?;
     Ok(shaper)
@@ -516,6 +568,49 @@ pub(crate) fn verify(shaper: &Shaper, modes: &[Mode], guarantee: &Guarantee) -> 
                             vtol * 100.0
                         ),
                     });
+                }
+            }
+        }
+        Guarantee::WithinTolerance { points, tolerance } => {
+            for &(f, z, vtol) in points {
+                let v = crate::vibration::vibration_rad(
+                    shaper.impulses(),
+                    2.0 * std::f64::consts::PI * f,
+                    z,
+                );
+                if v.is_nan() || v > vtol * (1.0 + tolerance) {
+                    return Err(Error::Infeasible {
+                        reason: format!(
+                            "the designed shaper leaves V = {:.4} % at {f} Hz, ζ = {z}, above \
+                             Vtol = {:.4} %",
+                            v * 100.0,
+                            vtol * 100.0
+                        ),
+                    });
+                }
+            }
+        }
+        Guarantee::ZeroDerivativesAtModes { derivatives } => {
+            let t_n = shaper.duration().max(f64::MIN_POSITIVE);
+            for (i, mode) in modes.iter().enumerate() {
+                for k in 0..=*derivatives {
+                    let [c, s] = crate::vibration::vibration_moment(
+                        shaper.impulses(),
+                        mode.omega_rad_s(),
+                        mode.damping(),
+                        k,
+                    );
+                    let m = c.hypot(s) / t_n.powi(k as i32);
+                    if m.is_nan() || m > ZERO_VIBRATION_TOLERANCE {
+                        return Err(Error::Infeasible {
+                            reason: format!(
+                                "the designed shaper leaves a vibration moment of order {k} of \
+                                 {m:.3e} at modes[{i}] ({} Hz, ζ = {})",
+                                mode.frequency_hz(),
+                                mode.damping()
+                            ),
+                        });
+                    }
                 }
             }
         }

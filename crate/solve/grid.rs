@@ -1,0 +1,211 @@
+//! The convex program on fixed impulse times, solved with Clarabel (an interior-point
+//! LP/QP/SOCP solver).
+//!
+//! With the times t₀ … t_N fixed and the last one t_N = T taken as the end of the shaper, every
+//! design constraint of the literature is linear or second-order-cone in the amplitudes A:
+//!
+//! - Σ Aₖ = 1 (Singhose 2009 eq. 12), amplitude bounds A_min ≤ Aₖ ≤ A_max and increment bounds
+//!   |Aₖ − Aₖ₋₁| ≤ ΔA_max (Kamel et al. eq. 7) are linear;
+//! - zero vibration and zero frequency derivatives at a mode are the linear equalities
+//!   M₀ = … = M_d = 0 of [`crate::vibration::vibration_moment`];
+//! - V(ωⱼ, ζⱼ) ≤ Vtolⱼ (Singhose 2009 eq. 18) says that the 2-vector Σ Aₖ pⱼ(tₖ), with pⱼ the
+//!   [`crate::vibration::impulse_phasor`], has length at most Vtolⱼ: a second-order cone.
+//!
+//! When there are vibration limits the program minimises the common level s with
+//! V(ωⱼ, ζⱼ) ≤ s·Vtolⱼ (so s ≤ 1 means feasible, and the solution is unique and sparse at the
+//! shortest feasible duration); otherwise it minimises the centroid Σ Aₖtₖ (an LP whose optimal
+//! vertex uses few grid points).
+
+use super::{NormalizedLimit, NormalizedProblem};
+use crate::error::{Error, Result};
+use crate::vibration::impulse_phasor;
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+
+/// Most iterations the interior-point solver may take on one program.
+const MAX_SOLVER_ITERATIONS: u32 = 200;
+
+/// What the program found on one set of times.
+#[derive(Debug, Clone)]
+pub(crate) struct Outcome {
+    /// Amplitudes at the given times.
+    pub amplitudes: Vec<f64>,
+    /// The smallest common level s with V ≤ s·Vtol at every limit (0 without limits).
+    pub level: f64,
+}
+
+/// Solves the program on `times` (sorted, first 0; the last is the shaper's end).
+/// `Ok(None)` when no amplitudes satisfy the linear constraints (or the solver fails, which
+/// the callers treat the same way: as "not feasible at this duration").
+pub(crate) fn solve_on_times(
+    problem: &NormalizedProblem,
+    limits: &[NormalizedLimit],
+    times: &[f64],
+    increment_max: Option<f64>,
+) -> Result<Option<Outcome>> {
+    let n_amp = times.len();
+    if n_amp == 0 {
+        return Err(Error::invalid("times", "at least one time is required"));
+    }
+    let t_end = times[n_amp - 1];
+    let has_level = !limits.is_empty();
+    let n = n_amp + usize::from(has_level);
+    let level_col = n_amp;
+
+    // Triplets (row, col, value) of A in A x + z = b, and b, in cone order.
+    let mut rows: Vec<usize> = Vec::new();
+    let mut cols: Vec<usize> = Vec::new();
+    let mut vals: Vec<f64> = Vec::new();
+    let mut b: Vec<f64> = Vec::new();
+    let mut push = |r: usize, c: usize, v: f64, rows: &mut Vec<usize>| {
+        if v != 0.0 {
+            rows.push(r);
+            cols.push(c);
+            vals.push(v);
+        }
+    };
+
+    // Zero cone: Σ A = 1, then the moment equalities.
+    let mut row = 0;
+    for k in 0..n_amp {
+        push(row, k, 1.0, &mut rows);
+    }
+    b.push(1.0);
+    row += 1;
+    for zero in &problem.zeros {
+        for order in 0..=zero.derivatives {
+            let mut coeffs = vec![[0.0; 2]; n_amp];
+            for (k, &t) in times.iter().enumerate() {
+                let p = impulse_phasor(t, t_end, zero.omega, zero.zeta);
+                let w = if order == 0 {
+                    1.0
+                } else {
+                    t.powi(order as i32)
+                };
+                coeffs[k] = [w * p[0], w * p[1]];
+            }
+            for part in 0..2 {
+                let scale = coeffs.iter().map(|c| c[part].abs()).fold(0.0_f64, f64::max);
+                if scale == 0.0 {
+                    continue; // e.g. the sine part at ω_d t = 0 only
+                }
+                for (k, c) in coeffs.iter().enumerate() {
+                    push(row, k, c[part] / scale, &mut rows);
+                }
+                b.push(0.0);
+                row += 1;
+            }
+        }
+    }
+    let n_zero = row;
+
+    // Nonnegative cone: bounds and increments. With A ≥ 0 and Σ A = 1, A ≤ 1 holds anyway, so
+    // an upper bound ≥ 1 is left out.
+    let upper = !(problem.amplitude_min >= 0.0 && problem.amplitude_max >= 1.0);
+    for k in 0..n_amp {
+        push(row, k, -1.0, &mut rows); // A_k − A_min ≥ 0
+        b.push(-problem.amplitude_min);
+        row += 1;
+        if upper {
+            push(row, k, 1.0, &mut rows); // A_max − A_k ≥ 0
+            b.push(problem.amplitude_max);
+            row += 1;
+        }
+    }
+    if let Some(d) = increment_max {
+        for k in 1..n_amp {
+            push(row, k, 1.0, &mut rows);
+            push(row, k - 1, -1.0, &mut rows);
+            b.push(d);
+            row += 1;
+            push(row, k, -1.0, &mut rows);
+            push(row, k - 1, 1.0, &mut rows);
+            b.push(d);
+            row += 1;
+        }
+    }
+    let n_nonneg = row - n_zero;
+
+    // Second-order cones: (Vtolⱼ s, Σ Aₖ pⱼ(tₖ)).
+    for limit in limits {
+        push(row, level_col, -limit.vtol, &mut rows);
+        b.push(0.0);
+        row += 1;
+        let phasors: Vec<[f64; 2]> = times
+            .iter()
+            .map(|&t| impulse_phasor(t, t_end, limit.omega, limit.zeta))
+            .collect();
+        for part in 0..2 {
+            for (k, p) in phasors.iter().enumerate() {
+                push(row, k, -p[part], &mut rows);
+            }
+            b.push(0.0);
+            row += 1;
+        }
+    }
+    let m = row;
+    if vals.iter().chain(b.iter()).any(|v| !v.is_finite()) {
+        return Err(Error::invalid(
+            "modes",
+            "the design program has non-finite coefficients (frequencies or times out of range)",
+        ));
+    }
+
+    let mut q = vec![0.0; n];
+    if has_level {
+        q[level_col] = 1.0;
+    } else if t_end > 0.0 {
+        for (k, &t) in times.iter().enumerate() {
+            q[k] = t / t_end;
+        }
+    }
+    let p = CscMatrix::zeros((n, n));
+    let a = CscMatrix::new_from_triplets(m, n, rows, cols, vals);
+    let mut cones = vec![SupportedConeT::ZeroConeT(n_zero)];
+    if n_nonneg > 0 {
+        cones.push(SupportedConeT::NonnegativeConeT(n_nonneg));
+    }
+    cones.extend(limits.iter().map(|_| SupportedConeT::SecondOrderConeT(3)));
+
+    let settings = DefaultSettings {
+        verbose: false,
+        max_iter: MAX_SOLVER_ITERATIONS,
+        presolve_enable: false,
+        // The duration search needs the level to ~1e-6; the polish makes the result exact.
+        tol_gap_abs: 1e-7,
+        tol_gap_rel: 1e-7,
+        tol_feas: 1e-7,
+        iterative_refinement_max_iter: 3,
+        ..DefaultSettings::default()
+    };
+    let Ok(mut solver) = DefaultSolver::new(&p, &q, &a, &b, &cones, settings) else {
+        return Err(Error::Infeasible {
+            reason: "the design program could not be set up".into(),
+        });
+    };
+    solver.solve();
+    let solution = &solver.solution;
+    match solution.status {
+        SolverStatus::Solved | SolverStatus::AlmostSolved => {}
+        _ => return Ok(None),
+    }
+    let amplitudes = solution.x[..n_amp].to_vec();
+    if amplitudes.iter().any(|a| !a.is_finite()) {
+        return Ok(None);
+    }
+    let level = if has_level {
+        // Recompute the level from the amplitudes rather than trusting the solver's s.
+        let imps: Vec<crate::shaper::Impulse> = times
+            .iter()
+            .zip(&amplitudes)
+            .map(|(&time, &amplitude)| crate::shaper::Impulse { time, amplitude })
+            .collect();
+        limits
+            .iter()
+            .map(|l| crate::vibration::vibration_rad(&imps, l.omega, l.zeta) / l.vtol)
+            .fold(0.0_f64, f64::max)
+    } else {
+        0.0
+    };
+    Ok(Some(Outcome { amplitudes, level }))
+}

@@ -1,0 +1,906 @@
+//! The numerical machinery the solved families share: the shortest shaper that meets a set of
+//! vibration constraints.
+//!
+//! A family states its constraints as a [`Problem`]: zero vibration (with zero frequency
+//! derivatives) at some modes, V ≤ Vtol at sampled (frequency, damping) points, and V ≤ Vtol(f)
+//! over whole bands of frequency and damping. [`minimum_duration`] then
+//!
+//! 1. **grid + bisection** (`grid.rs`): for a candidate duration T it places impulses on a fine
+//!    grid of times in [0, T] and solves a convex program for the amplitudes (linear
+//!    constraints and second-order cones, Clarabel); the shortest feasible T is found by
+//!    bisection. For a fixed grid this is the global optimum, so the result is the globally
+//!    shortest shaper up to the grid spacing, whatever its number of impulses;
+//! 2. **reduction**: neighbouring grid impulses are merged into the few impulses the solution
+//!    really uses;
+//! 3. **polish** (`polish.rs`): the times and amplitudes of those impulses (and the frequencies
+//!    of the sensitivity humps that touch Vtol) are refined by Newton's method on the active
+//!    constraints with the shortest duration as objective (a reduced-Hessian SQP), so the
+//!    result is exact, not grid-limited;
+//! 4. **guarantee** (`scan.rs`): the result is checked at every sampled point and on a dense
+//!    grid over every band (local maxima refined); where a band is exceeded the offending points
+//!    are added to the program's constraints and the design is repeated (an exchange, or
+//!    cutting-plane, loop) until the guarantee holds.
+//!
+//! Internally everything is non-dimensional: times in periods of the highest frequency of the
+//! problem, so the numbers stay O(1) for any mode from millihertz to megahertz. Every iteration
+//! is bounded (see the constants below).
+
+pub(crate) mod grid;
+pub(crate) mod polish;
+pub(crate) mod scan;
+
+use crate::error::{finite, Error, Result};
+use crate::shaper::{Impulse, Shaper};
+use crate::vibration::vibration_rad;
+use std::f64::consts::PI;
+
+/// Grid points per period of the highest frequency of the problem.
+const POINTS_PER_CYCLE: f64 = 16.0;
+/// Fewest grid intervals on [0, T].
+const MIN_POINTS: usize = 24;
+/// Longest duration the grid can represent, in periods of the highest frequency (keeps the
+/// program at most `POINTS_PER_CYCLE × MAX_CYCLES` amplitudes).
+pub const MAX_CYCLES: f64 = 40.0;
+/// Most rounds of the exchange loop (adding band points where the bound is exceeded).
+const MAX_EXCHANGE_ROUNDS: usize = 8;
+/// Most times the grid is refined around the solution's impulses when the polish fails.
+const MAX_REFINEMENTS: usize = 2;
+/// Refined points per cluster on each side of its centre, and how much finer they are.
+const REFINE_POINTS: i32 = 6;
+const REFINE_FACTOR: f64 = 4.0;
+/// Most convex programs one bisection may solve.
+const MAX_PROGRAMS: usize = 60;
+/// Relative slack by which a grid solution must beat Vtol to count as feasible.
+const FEASIBILITY_MARGIN: f64 = 1e-6;
+/// Relative excess over Vtol tolerated when checking a result (rounding).
+pub const CHECK_TOLERANCE: f64 = 1e-9;
+/// Largest zero-vibration moment (scaled by t_nᵏ) accepted as zero.
+pub const ZERO_TOLERANCE: f64 = 1e-9;
+
+/// Most points a Vtol profile may have.
+pub const MAX_PROFILE_POINTS: usize = 1000;
+
+/// A tolerable-vibration level that may vary with frequency: piecewise linear through
+/// `(frequency in Hz, Vtol)` points, constant beyond the first and last.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tolerance {
+    points: Vec<(f64, f64)>,
+}
+
+impl Tolerance {
+    /// The same Vtol at every frequency.
+    pub fn constant(vtol: f64) -> Result<Self> {
+        Tolerance::profile(vec![(0.0, vtol)])
+    }
+
+    /// Vtol linear between the given `(frequency in Hz, Vtol)` points (sorted by frequency,
+    /// distinct), constant outside them. Each Vtol must lie in (0, 1).
+    pub fn profile(points: Vec<(f64, f64)>) -> Result<Self> {
+        if points.is_empty() {
+            return Err(Error::invalid("vtolProfile", "give at least one point"));
+        }
+        crate::error::count("vtolProfile", points.len(), 1, MAX_PROFILE_POINTS)?;
+        for (i, &(f, v)) in points.iter().enumerate() {
+            finite(&format!("vtolProfile[{i}][0]"), f)?;
+            finite(&format!("vtolProfile[{i}][1]"), v)?;
+            if f < 0.0 {
+                return Err(Error::invalid(
+                    format!("vtolProfile[{i}][0]"),
+                    format!("frequency must be ≥ 0 Hz, got {f}"),
+                ));
+            }
+            if !(v > 0.0 && v < 1.0) {
+                return Err(Error::invalid(
+                    format!("vtolProfile[{i}][1]"),
+                    format!("tolerable vibration must lie in (0, 1), got {v}"),
+                ));
+            }
+            if i > 0 && f <= points[i - 1].0 {
+                return Err(Error::invalid(
+                    format!("vtolProfile[{i}][0]"),
+                    "frequencies must be strictly increasing",
+                ));
+            }
+        }
+        Ok(Tolerance { points })
+    }
+
+    /// Vtol at `frequency_hz`.
+    pub fn at(&self, frequency_hz: f64) -> f64 {
+        let pts = &self.points;
+        let (first, last) = (pts[0], pts[pts.len() - 1]);
+        if frequency_hz <= first.0 {
+            return first.1;
+        }
+        if frequency_hz >= last.0 {
+            return last.1;
+        }
+        for w in pts.windows(2) {
+            let ((f0, v0), (f1, v1)) = (w[0], w[1]);
+            if frequency_hz <= f1 {
+                return v0 + (v1 - v0) * (frequency_hz - f0) / (f1 - f0);
+            }
+        }
+        last.1
+    }
+
+    /// The smallest Vtol anywhere.
+    pub fn min(&self) -> f64 {
+        self.points
+            .iter()
+            .map(|p| p.1)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    fn scaled(&self, f_ref: f64) -> Vec<(f64, f64)> {
+        self.points.iter().map(|&(f, v)| (f / f_ref, v)).collect()
+    }
+}
+
+/// Zero vibration and `derivatives` zero frequency derivatives at a mode (the ZV/ZVD/ZV-Dⁿ
+/// constraints of Singer & Seering 1988, imposed as vanishing moments).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ZeroVibration {
+    /// Undamped natural frequency in Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping: f64,
+    /// Number of zero derivatives (0 = ZV, 1 = ZVD, …).
+    pub derivatives: u32,
+}
+
+/// V ≤ `vtol` at one (frequency, damping) point (Singhose 2009 eq. 18).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limit {
+    /// Frequency in Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio.
+    pub damping: f64,
+    /// Tolerable vibration (fraction).
+    pub vtol: f64,
+}
+
+/// V ≤ Vtol(f) everywhere on a band of frequencies and damping ratios.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Band {
+    /// Lowest frequency in Hz.
+    pub from_hz: f64,
+    /// Highest frequency in Hz.
+    pub to_hz: f64,
+    /// Lowest damping ratio.
+    pub damping_from: f64,
+    /// Highest damping ratio (equal to `damping_from` for a single damping).
+    pub damping_to: f64,
+    /// Tolerable vibration over the band.
+    pub tolerance: Tolerance,
+}
+
+/// The constraints of a minimum-duration design.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    /// Modes with zero vibration (and derivatives).
+    pub zeros: Vec<ZeroVibration>,
+    /// Sampled vibration limits.
+    pub limits: Vec<Limit>,
+    /// Bands where the vibration limit must hold everywhere.
+    pub bands: Vec<Band>,
+    /// Smallest amplitude allowed (0 for positive shapers, e.g. −1 for negative ones).
+    pub amplitude_min: f64,
+    /// Largest amplitude allowed.
+    pub amplitude_max: f64,
+    /// Longest duration accepted, in seconds (`None`: up to [`MAX_CYCLES`] periods of the
+    /// highest frequency).
+    pub max_duration: Option<f64>,
+}
+
+/// A point at which a design was checked: (frequency in Hz, damping ratio, Vtol there).
+pub type CheckedPoint = (f64, f64, f64);
+
+/// The result of [`minimum_duration`].
+#[derive(Debug, Clone)]
+pub struct Design {
+    /// The shaper (times in seconds).
+    pub shaper: Shaper,
+    /// Whether the Newton polish converged (the result is then exact and locally optimal;
+    /// otherwise it is the grid solution, feasible but up to a grid step longer).
+    pub polished: bool,
+    /// Every point where V was checked against its Vtol (sampled limits, and the dense grid
+    /// and refined maxima over each band).
+    pub checked: Vec<CheckedPoint>,
+    /// Convex programs solved.
+    pub programs: usize,
+    /// Rounds of the exchange loop (1 when the first design already met every band).
+    pub rounds: usize,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Non-dimensional form
+
+/// A zero-vibration constraint in normalized units (ω in rad per normalized time unit).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NormalizedZero {
+    pub omega: f64,
+    pub zeta: f64,
+    pub derivatives: u32,
+}
+
+/// A vibration limit in normalized units.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NormalizedLimit {
+    pub omega: f64,
+    pub zeta: f64,
+    pub vtol: f64,
+}
+
+/// A band in normalized units; Vtol is piecewise linear in ω.
+#[derive(Debug, Clone)]
+pub(crate) struct NormalizedBand {
+    pub omega_lo: f64,
+    pub omega_hi: f64,
+    pub zeta_lo: f64,
+    pub zeta_hi: f64,
+    /// (ω, Vtol) points.
+    pub tolerance: Vec<(f64, f64)>,
+}
+
+impl NormalizedBand {
+    pub fn vtol(&self, omega: f64) -> f64 {
+        let pts = &self.tolerance;
+        let (first, last) = (pts[0], pts[pts.len() - 1]);
+        if omega <= first.0 {
+            return first.1;
+        }
+        if omega >= last.0 {
+            return last.1;
+        }
+        for w in pts.windows(2) {
+            let ((w0, v0), (w1, v1)) = (w[0], w[1]);
+            if omega <= w1 {
+                return v0 + (v1 - v0) * (omega - w0) / (w1 - w0);
+            }
+        }
+        last.1
+    }
+}
+
+/// The problem with times in periods of `f_ref` (the highest frequency) and ω = 2πf/f_ref.
+#[derive(Debug, Clone)]
+pub(crate) struct NormalizedProblem {
+    pub f_ref: f64,
+    pub zeros: Vec<NormalizedZero>,
+    pub limits: Vec<NormalizedLimit>,
+    pub bands: Vec<NormalizedBand>,
+    pub amplitude_min: f64,
+    pub amplitude_max: f64,
+    /// Longest duration, normalized.
+    pub max_duration: f64,
+    /// Lowest constrained ω.
+    pub omega_min: f64,
+}
+
+fn check_damping(field: &str, zeta: f64) -> Result<()> {
+    crate::vibration::damping_ratio(field, zeta).map(|_| ())
+}
+
+fn check_frequency(field: &str, f: f64) -> Result<()> {
+    finite(field, f)?;
+    if !(crate::mode::MIN_FREQUENCY_HZ..=crate::mode::MAX_FREQUENCY_HZ).contains(&f) {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must lie between {} and {} Hz, got {f}",
+                crate::mode::MIN_FREQUENCY_HZ,
+                crate::mode::MAX_FREQUENCY_HZ
+            ),
+        ));
+    }
+    Ok(())
+}
+
+impl NormalizedProblem {
+    fn new(p: &Problem) -> Result<Self> {
+        finite("amplitudeMin", p.amplitude_min)?;
+        finite("amplitudeMax", p.amplitude_max)?;
+        if p.amplitude_max <= 0.0 || p.amplitude_min >= p.amplitude_max || p.amplitude_min > 1.0 {
+            return Err(Error::invalid(
+                "amplitudeMax",
+                format!(
+                    "need amplitudeMin < amplitudeMax, amplitudeMax > 0 and amplitudeMin ≤ 1, got \
+                     [{}, {}]",
+                    p.amplitude_min, p.amplitude_max
+                ),
+            ));
+        }
+        let mut f_ref: f64 = 0.0;
+        let mut f_min = f64::INFINITY;
+        for (i, z) in p.zeros.iter().enumerate() {
+            check_frequency(&format!("modes[{i}].frequencyHz"), z.frequency_hz)?;
+            check_damping(&format!("modes[{i}].damping"), z.damping)?;
+            f_ref = f_ref.max(z.frequency_hz);
+            f_min = f_min.min(z.frequency_hz);
+        }
+        for l in &p.limits {
+            check_frequency("sampleFrequenciesHz", l.frequency_hz)?;
+            check_damping("damping", l.damping)?;
+            if !(l.vtol > 0.0 && l.vtol < 1.0) {
+                return Err(Error::invalid(
+                    "vtol",
+                    format!("must lie in (0, 1), got {}", l.vtol),
+                ));
+            }
+            f_ref = f_ref.max(l.frequency_hz);
+            f_min = f_min.min(l.frequency_hz);
+        }
+        for b in &p.bands {
+            check_frequency("bandHz[0]", b.from_hz)?;
+            check_frequency("bandHz[1]", b.to_hz)?;
+            if b.to_hz < b.from_hz {
+                return Err(Error::invalid("bandHz", "the band's ends are reversed"));
+            }
+            check_damping("dampingRange[0]", b.damping_from)?;
+            check_damping("dampingRange[1]", b.damping_to)?;
+            if b.damping_to < b.damping_from {
+                return Err(Error::invalid(
+                    "dampingRange",
+                    "the range's ends are reversed",
+                ));
+            }
+            f_ref = f_ref.max(b.to_hz);
+            f_min = f_min.min(b.from_hz);
+        }
+        if f_ref <= 0.0 {
+            return Err(Error::invalid(
+                "modes",
+                "the design has no constraint (no mode, sample or band)",
+            ));
+        }
+        let w = |f: f64| 2.0 * PI * f / f_ref;
+        let max_duration = match p.max_duration {
+            Some(d) => {
+                crate::error::positive("maxDuration", d)?;
+                (d * f_ref).min(MAX_CYCLES)
+            }
+            None => MAX_CYCLES,
+        };
+        Ok(NormalizedProblem {
+            f_ref,
+            zeros: p
+                .zeros
+                .iter()
+                .map(|z| NormalizedZero {
+                    omega: w(z.frequency_hz),
+                    zeta: z.damping,
+                    derivatives: z.derivatives,
+                })
+                .collect(),
+            limits: p
+                .limits
+                .iter()
+                .map(|l| NormalizedLimit {
+                    omega: w(l.frequency_hz),
+                    zeta: l.damping,
+                    vtol: l.vtol,
+                })
+                .collect(),
+            bands: p
+                .bands
+                .iter()
+                .map(|b| NormalizedBand {
+                    omega_lo: w(b.from_hz),
+                    omega_hi: w(b.to_hz),
+                    zeta_lo: b.damping_from,
+                    zeta_hi: b.damping_to,
+                    tolerance: b
+                        .tolerance
+                        .scaled(f_ref)
+                        .into_iter()
+                        .map(|(f, v)| (2.0 * PI * f, v))
+                        .collect(),
+                })
+                .collect(),
+            amplitude_min: p.amplitude_min,
+            amplitude_max: p.amplitude_max,
+            max_duration,
+            omega_min: w(f_min),
+        })
+    }
+
+    /// A shaper in normalized units back in seconds.
+    fn to_seconds(&self, impulses: &[Impulse]) -> Result<Shaper> {
+        Shaper::new(
+            impulses
+                .iter()
+                .map(|imp| Impulse {
+                    time: imp.time / self.f_ref,
+                    amplitude: imp.amplitude,
+                })
+                .collect(),
+        )
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The driver
+
+/// The shortest shaper meeting `problem`'s constraints (see the module docs for the method).
+///
+/// Errors: [`Error::InvalidInput`] for out-of-range data, [`Error::Infeasible`] when no shaper
+/// within the duration limit meets the constraints (with the reason).
+pub fn minimum_duration(problem: &Problem) -> Result<Design> {
+    let norm = NormalizedProblem::new(problem)?;
+    let mut samples: Vec<NormalizedLimit> = norm.limits.clone();
+    for band in &norm.bands {
+        samples.extend(scan::initial_samples(band));
+    }
+    let mut programs = 0;
+    for round in 1..=MAX_EXCHANGE_ROUNDS {
+        let mut grid = shortest_on_grid(&norm, &samples, None, &mut programs)?;
+        // Neighbouring grid impulses that add up beyond the amplitude bounds mean the grid is
+        // emulating impulses the bounds forbid (binding bounds, e.g. negative shapers): no
+        // few-impulse structure to polish, and finer grids only emulate more closely.
+        let beyond_bounds = clusters(&grid).iter().any(|c| {
+            c.amplitude > norm.amplitude_max * (1.0 + 1e-3)
+                || c.amplitude < norm.amplitude_min * (1.0 + 1e-3)
+        });
+        let mut polished = if beyond_bounds {
+            None
+        } else {
+            polish::polish(&norm, &grid)
+        };
+        if polished.is_none() && round < MAX_EXCHANGE_ROUNDS {
+            // The polish failed. If the grid solution itself exceeds a band between the samples,
+            // the samples are too few to fix the structure: add its maxima and start again.
+            let raw: Vec<Impulse> = grid
+                .times
+                .iter()
+                .zip(&grid.amplitudes)
+                .map(|(&time, &amplitude)| Impulse { time, amplitude })
+                .collect();
+            let violations = scan::check(&norm, &raw).violations;
+            if !violations.is_empty() {
+                samples.extend(violations);
+                continue;
+            }
+        }
+        // If the polish still fails (impulses too close for the grid to resolve, a poor
+        // start), refine the grid around the impulses the solution uses and try again.
+        for _ in 0..MAX_REFINEMENTS {
+            if polished.is_some() || beyond_bounds {
+                break;
+            }
+            let pattern = refine_pattern(&grid);
+            grid = shortest_on_grid(
+                &norm,
+                &samples,
+                Some((&pattern, grid.duration)),
+                &mut programs,
+            )?;
+            polished = polish::polish(&norm, &grid);
+        }
+        let (impulses, polished) = match polished {
+            Some(imps) => (imps, true),
+            None => (fallback(&norm, &samples, &grid, &mut programs)?, false),
+        };
+        let report = scan::check(&norm, &impulses);
+        if report.worst_limit > 1.0 + CHECK_TOLERANCE || report.worst_moment > ZERO_TOLERANCE {
+            // Not something more samples can fix: the numbers are at their limits.
+            return Err(Error::Infeasible {
+                reason: format!(
+                    "the design could not meet its constraints to rounding (V/Vtol = {:.6} at \
+                     the samples, zero-vibration residual {:.2e}): the problem is numerically \
+                     too hard (modes too far apart or too many constraints)",
+                    report.worst_limit, report.worst_moment
+                ),
+            });
+        }
+        if report.violations.is_empty() {
+            let shaper = norm.to_seconds(&impulses)?;
+            let checked = report
+                .checked
+                .iter()
+                .map(|&(w, z, v)| (w * norm.f_ref / (2.0 * PI), z, v))
+                .collect();
+            return Ok(Design {
+                shaper,
+                polished,
+                checked,
+                programs,
+                rounds: round,
+            });
+        }
+        samples.extend(report.violations);
+    }
+    Err(Error::Infeasible {
+        reason: format!(
+            "the vibration bound could not be met everywhere on the band after \
+             {MAX_EXCHANGE_ROUNDS} rounds of refinement"
+        ),
+    })
+}
+
+/// The grid solution of the shortest feasible duration.
+#[derive(Debug, Clone)]
+pub(crate) struct GridSolution {
+    /// Grid times (normalized), the last one the duration.
+    pub times: Vec<f64>,
+    /// Amplitudes at those times.
+    pub amplitudes: Vec<f64>,
+    /// The duration (the last time).
+    pub duration: f64,
+}
+
+/// Grid intervals for a duration `t` (normalized).
+fn grid_intervals(t: f64) -> usize {
+    ((POINTS_PER_CYCLE * t).ceil() as usize).max(MIN_POINTS)
+}
+
+fn grid_times(t: f64) -> Vec<f64> {
+    let n = grid_intervals(t);
+    (0..=n).map(|k| t * k as f64 / n as f64).collect()
+}
+
+/// One evaluation of the grid program at a duration: its level (V/Vtol reachable; `INFINITY`
+/// when the linear constraints cannot be met) and the solution.
+struct Probe {
+    t: f64,
+    level: f64,
+    solution: Option<GridSolution>,
+}
+
+/// The shortest duration whose grid program is feasible.
+///
+/// With vibration limits, the program's optimal level s(T) (the smallest common V/Vtol the
+/// amplitudes can reach) falls as T grows, and the answer is the first T with s(T) ≤ 1: it is
+/// bracketed by stepping T up (or down) by ×1.5 from half a period of the lowest constrained
+/// frequency, then found by regula falsi on ln s(T) (Illinois variant; each step also halves
+/// the bracket at worst, as bisection would). Without limits (zero-vibration equalities only)
+/// feasibility is all there is, and plain bisection is used. Either way it stops once the
+/// bracket is below half a grid step, and after at most [`MAX_PROGRAMS`] programs.
+fn shortest_on_grid(
+    norm: &NormalizedProblem,
+    samples: &[NormalizedLimit],
+    refined: Option<(&[f64], f64)>,
+    programs: &mut usize,
+) -> Result<GridSolution> {
+    let solved = std::cell::Cell::new(0usize);
+    // Times for a duration: the uniform grid, or a refined pattern (relative times) scaled.
+    let times_for = |t: f64| -> Vec<f64> {
+        match refined {
+            None => grid_times(t),
+            Some((pattern, _)) => pattern.iter().map(|s| s * t).collect(),
+        }
+    };
+    // The finest spacing of the grid at duration t: the bracket is shrunk to half of it.
+    let resolution = |t: f64| -> f64 {
+        match refined {
+            None => t / grid_intervals(t) as f64,
+            Some((pattern, _)) => {
+                t * pattern
+                    .windows(2)
+                    .map(|w| w[1] - w[0])
+                    .fold(f64::INFINITY, f64::min)
+            }
+        }
+    };
+    let tight_level = if refined.is_some() { -1e-5 } else { -1e-2 };
+    let mut probe = |t: f64| -> Result<Probe> {
+        solved.set(solved.get() + 1);
+        *programs += 1;
+        let times = times_for(t);
+        let outcome = grid::solve_on_times(norm, samples, &times, None)?;
+        Ok(match outcome {
+            Some(o) => Probe {
+                t,
+                level: if samples.is_empty() { 0.0 } else { o.level },
+                solution: Some(GridSolution {
+                    times,
+                    amplitudes: o.amplitudes,
+                    duration: t,
+                }),
+            },
+            None => Probe {
+                t,
+                level: f64::INFINITY,
+                solution: None,
+            },
+        })
+    };
+    let ok = |p: &Probe| p.level <= 1.0 - FEASIBILITY_MARGIN && p.solution.is_some();
+    let limit = norm.max_duration;
+
+    // Bracket [lo, hi]: lo infeasible (or 0), hi feasible. A refined grid starts from the
+    // coarse answer, which it can reproduce, and steps down from it.
+    let start = match refined {
+        Some((_, known)) => known,
+        None => (PI / norm.omega_min).min(limit),
+    };
+    let first = probe(start)?;
+    let down = if refined.is_some() { 1.02 } else { 1.5 };
+    let (mut lo, mut hi) = if ok(&first) {
+        let mut hi = first;
+        loop {
+            let t = hi.t / down;
+            if t < 1e-3 {
+                break (
+                    Probe {
+                        t: 0.0,
+                        level: f64::INFINITY,
+                        solution: None,
+                    },
+                    hi,
+                );
+            }
+            let p = probe(t)?;
+            if ok(&p) {
+                hi = p;
+            } else {
+                break (p, hi);
+            }
+        }
+    } else {
+        let mut lo = first;
+        let mut previous: Option<(f64, f64)> = None;
+        loop {
+            if lo.t >= limit {
+                return Err(Error::Infeasible {
+                    reason: infeasible_reason(norm),
+                });
+            }
+            // Step ×1.5, or to just past where the secant through the last two levels
+            // crosses 1 (kept within ×1.1 … ×2).
+            let f = lo.level.ln();
+            let step = match previous {
+                Some((t0, f0)) if f.is_finite() && f0.is_finite() && f0 > f && f > 0.0 => {
+                    let root = lo.t + (lo.t - t0) * f / (f0 - f);
+                    (1.02 * root).clamp(1.1 * lo.t, 2.0 * lo.t)
+                }
+                _ => 1.5 * lo.t,
+            };
+            let p = probe(step.min(limit))?;
+            if ok(&p) {
+                break (lo, p);
+            }
+            previous = Some((lo.t, f));
+            lo = p;
+        }
+    };
+
+    // Shrink the bracket.
+    let mut side = 0i32; // Illinois: which end was kept last time
+    let (mut f_lo, mut f_hi) = (lo.level.ln(), hi.level.ln());
+    while hi.t - lo.t > resolution(hi.t) && solved.get() < MAX_PROGRAMS {
+        let mid = 0.5 * (lo.t + hi.t);
+        let t = if f_lo.is_finite() && f_hi.is_finite() && f_lo > f_hi {
+            // Root of the line through (lo, f_lo), (hi, f_hi), kept inside the middle 90 %.
+            let r = lo.t + (hi.t - lo.t) * f_lo / (f_lo - f_hi);
+            r.clamp(lo.t + 0.05 * (hi.t - lo.t), hi.t - 0.05 * (hi.t - lo.t))
+        } else {
+            mid
+        };
+        let p = probe(t)?;
+        let f = p.level.ln();
+        if ok(&p) {
+            // Already within a fraction of the level of the bound: close enough.
+            let tight = f > tight_level;
+            hi = p;
+            f_hi = f;
+            if side == 1 {
+                f_lo *= 0.5;
+            }
+            side = 1;
+            if tight {
+                break;
+            }
+        } else {
+            lo = p;
+            f_lo = f;
+            if side == -1 {
+                f_hi *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    hi.solution.ok_or_else(|| Error::Infeasible {
+        reason: infeasible_reason(norm),
+    })
+}
+
+fn infeasible_reason(norm: &NormalizedProblem) -> String {
+    let seconds = norm.max_duration / norm.f_ref;
+    if norm.max_duration >= MAX_CYCLES {
+        format!(
+            "no shaper of up to {MAX_CYCLES} periods of the highest frequency ({seconds:.6} s) \
+             meets the constraints with amplitudes in [{}, {}]: narrow the band, raise vtol or \
+             widen the amplitude bounds",
+            norm.amplitude_min, norm.amplitude_max
+        )
+    } else {
+        format!(
+            "no shaper of at most maxDuration = {seconds} s meets the constraints with \
+             amplitudes in [{}, {}]: allow a longer duration, narrow the band or raise vtol",
+            norm.amplitude_min, norm.amplitude_max
+        )
+    }
+}
+
+/// A run of neighbouring grid impulses of one sign: the impulse it stands for.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Cluster {
+    /// Amplitude-weighted mean time.
+    pub time: f64,
+    /// Sum of the amplitudes.
+    pub amplitude: f64,
+    /// Amplitude-weighted standard deviation of the times.
+    pub spread: f64,
+    /// Grid spacing around the cluster.
+    pub spacing: f64,
+}
+
+/// Neighbouring grid impulses of the same sign grouped into clusters. An impulse between two
+/// grid points shows as two or three neighbours; a run is split where it dips to a local
+/// minimum below a tenth of its neighbours (two impulses close together).
+pub(crate) fn clusters(grid: &GridSolution) -> Vec<Cluster> {
+    let a = &grid.amplitudes;
+    let t = &grid.times;
+    let max = a.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+    let threshold = 1e-6 * max;
+    let significant = |k: usize| a[k].abs() > threshold;
+    let mut out: Vec<Cluster> = Vec::new();
+    let mut k = 0;
+    while k < a.len() {
+        if !significant(k) {
+            k += 1;
+            continue;
+        }
+        let sign = a[k].signum();
+        let (mut sum, mut moment, mut second) = (0.0, 0.0, 0.0);
+        let start = k;
+        while k < a.len() && significant(k) && a[k].signum() == sign {
+            let dip = k > start
+                && k + 1 < a.len()
+                && a[k].abs() <= a[k - 1].abs()
+                && a[k].abs() <= a[k + 1].abs()
+                && a[k + 1].signum() == sign
+                && a[k].abs() < 0.1 * a[k - 1].abs().min(a[k + 1].abs());
+            if dip {
+                break;
+            }
+            sum += a[k];
+            moment += a[k] * t[k];
+            second += a[k] * t[k] * t[k];
+            k += 1;
+        }
+        let end = k;
+        if k < a.len() && significant(k) && a[k].signum() == sign && k > start {
+            // Split at a dip: the dip's own (tiny) amplitude is left out.
+            k += 1;
+        }
+        if sum.abs() > 1e-4 * max {
+            let mean = moment / sum;
+            let spacing = (start.saturating_sub(1)..end.min(t.len().saturating_sub(1)))
+                .map(|i| t[i + 1] - t[i])
+                .fold(f64::INFINITY, f64::min);
+            out.push(Cluster {
+                time: mean,
+                amplitude: sum,
+                spread: (second / sum - mean * mean).max(0.0).sqrt(),
+                spacing: if spacing.is_finite() { spacing } else { 0.0 },
+            });
+        }
+    }
+    out
+}
+
+/// The clusters as impulses (amplitude: the sum; time: the amplitude-weighted mean, which
+/// matches the phasor to first order in the spacing).
+pub(crate) fn merge(grid: &GridSolution) -> Vec<Impulse> {
+    clusters(grid)
+        .iter()
+        .map(|c| Impulse {
+            time: c.time,
+            amplitude: c.amplitude,
+        })
+        .collect()
+}
+
+/// A finer time pattern (relative times in [0, 1]) for a grid solution: its own points plus,
+/// around every cluster of impulses it uses, points [`REFINE_FACTOR`] times closer together.
+fn refine_pattern(grid: &GridSolution) -> Vec<f64> {
+    let t = grid.duration.max(f64::MIN_POSITIVE);
+    let rel: Vec<f64> = grid.times.iter().map(|x| x / t).collect();
+    let mut pattern = rel.clone();
+    let max = grid.amplitudes.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+    for imp in merge(grid) {
+        let centre = imp.time / t;
+        // Local spacing: the gap of the pattern around the centre.
+        let k = rel.partition_point(|&x| x < centre);
+        let gap = |i: usize| rel.get(i + 1).zip(rel.get(i)).map(|(b, a)| b - a);
+        let h = [k.checked_sub(1).and_then(gap), gap(k)]
+            .into_iter()
+            .flatten()
+            .fold(f64::INFINITY, f64::min);
+        if !h.is_finite() || imp.amplitude.abs() <= 1e-4 * max {
+            continue;
+        }
+        for j in -REFINE_POINTS..=REFINE_POINTS {
+            let x = centre + f64::from(j) * h / REFINE_FACTOR;
+            if (0.0..=1.0).contains(&x) {
+                pattern.push(x);
+            }
+        }
+    }
+    pattern.sort_by(f64::total_cmp);
+    pattern.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    if let Some(last) = pattern.last_mut() {
+        *last = 1.0;
+    }
+    if let Some(first) = pattern.first_mut() {
+        *first = 0.0;
+    }
+    pattern
+}
+
+/// When the polish fails: the grid solution itself, on the grid points it really uses, with
+/// the amplitudes re-solved there (and the equalities made exact by projection). The support
+/// is the points above 10⁻⁶ of the largest amplitude (the interior-point solver leaves ~10⁻¹⁰
+/// elsewhere); if the program is not feasible on it, every point above 10⁻⁹ is kept.
+fn fallback(
+    norm: &NormalizedProblem,
+    samples: &[NormalizedLimit],
+    grid: &GridSolution,
+    programs: &mut usize,
+) -> Result<Vec<Impulse>> {
+    let max = grid.amplitudes.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+    for threshold in [1e-6, 1e-9] {
+        let mut times: Vec<f64> = grid
+            .times
+            .iter()
+            .zip(&grid.amplitudes)
+            .filter(|(_, a)| a.abs() > threshold * max)
+            .map(|(&t, _)| t)
+            .collect();
+        // Keep the grid's ends so V is measured from the same instant.
+        if let Some(&end) = grid.times.last() {
+            if times.last() != Some(&end) {
+                times.push(end);
+            }
+        }
+        if times.first() != Some(&0.0) {
+            times.insert(0, 0.0);
+        }
+        *programs += 1;
+        let Some(outcome) = grid::solve_on_times(norm, samples, &times, None)? else {
+            continue;
+        };
+        if !samples.is_empty() && outcome.level > 1.0 {
+            continue;
+        }
+        let mut impulses: Vec<Impulse> = times
+            .iter()
+            .zip(&outcome.amplitudes)
+            .map(|(&time, &amplitude)| Impulse { time, amplitude })
+            .collect();
+        if !norm.zeros.is_empty() {
+            polish::project_equalities(norm, &mut impulses);
+        }
+        // Drop the solver's zeros except the first and last, which fix t = 0 and t_n.
+        let n = impulses.len();
+        return Ok(impulses
+            .into_iter()
+            .enumerate()
+            .filter(|(i, imp)| *i == 0 || *i + 1 == n || imp.amplitude.abs() > 1e-12)
+            .map(|(_, imp)| imp)
+            .collect());
+    }
+    Err(Error::Infeasible {
+        reason: "the design program is numerically degenerate (modes very close together for \
+                 this many derivatives, or constraints at the limits of precision): the grid \
+                 solution could not be reproduced on its own impulse times"
+            .into(),
+    })
+}
+
+/// V(ω, ζ) / Vtol on a normalized impulse sequence.
+pub(crate) fn ratio(impulses: &[Impulse], omega: f64, zeta: f64, vtol: f64) -> f64 {
+    vibration_rad(impulses, omega, zeta) / vtol
+}

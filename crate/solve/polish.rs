@@ -1,0 +1,984 @@
+//! Newton polish of a grid solution: exact times and amplitudes, shortest duration.
+//!
+//! The grid solution, merged to a few impulses, fixes the structure of the answer: how many
+//! impulses, which constraints are active (V = Vtol at which sampled points and at which
+//! sensitivity humps of a band, which amplitudes sit at a bound). The polish then solves
+//!
+//!   minimise t_n  subject to  c(y) = 0 (the active constraints),
+//!
+//! for y = (t₁ … t_n, A₀ … A_n, the frequencies/dampings of the active humps), with t₀ = 0. A
+//! hump inside a band is a maximum of V/Vtol, so it contributes two equations: V/Vtol = 1 and
+//! ∂(ln V/Vtol)/∂ω = 0 (and ∂/∂ζ = 0 inside a damping range). The method is a reduced-Hessian
+//! SQP: a Gauss–Newton step onto c = 0 (pseudo-inverse of the Jacobian) plus a Newton step on
+//! the duration in the null space of the Jacobian, whose Hessian is taken by finite differences
+//! of the Lagrangian. When the active constraints are as many as the unknowns this is plain
+//! Newton on c = 0. An outer active-set loop drops constraints whose multiplier has the wrong
+//! sign and adds those the result violates. All loops are bounded; on failure the caller falls
+//! back to the (feasible, slightly longer) grid solution.
+
+use super::scan::{band_peaks, Peak};
+use super::{clusters, ratio, Cluster, GridSolution, NormalizedProblem, CHECK_TOLERANCE};
+use crate::shaper::Impulse;
+use crate::vibration::{impulse_phasor, vibration_moment};
+use nalgebra::{DMatrix, DVector};
+
+/// Most clusters split in two when looking for a structure that polishes.
+const MAX_SPLITS: usize = 2;
+/// Newton/SQP iterations per active set.
+const MAX_NEWTON_ITERATIONS: usize = 60;
+/// Active-set changes tried.
+const MAX_ACTIVE_SET_ROUNDS: usize = 16;
+/// Active points left out in turn when the active set is inconsistent.
+const MAX_DROPS: usize = 4;
+/// Gauss–Newton gives up when ‖c‖ has not halved in this many iterations.
+const STALL_ITERATIONS: usize = 6;
+/// Candidates within this of the highest V/Vtol on the grid solution start out active.
+const ACTIVE_BAND: f64 = 0.05;
+/// Converged when every residual is below this.
+const RESIDUAL_TOLERANCE: f64 = 1e-13;
+/// … and the reduced gradient of the duration is below this.
+const GRADIENT_TOLERANCE: f64 = 1e-9;
+/// Above this largest residual, steps only restore c = 0.
+const RESTORATION_THRESHOLD: f64 = 1e-4;
+/// Largest null-space step per unknown (normalized units: periods of the highest frequency,
+/// amplitudes, rad per period).
+const MAX_NULL_STEP: f64 = 0.05;
+/// Finite-difference step for the Jacobian.
+const JACOBIAN_STEP: f64 = 1e-7;
+/// Finite-difference step for the reduced Hessian.
+const HESSIAN_STEP: f64 = 1e-4;
+
+/// A coordinate of an active point: fixed, or the unknown at `index` of y.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Coord {
+    Fixed(f64),
+    Free(usize),
+}
+
+/// Where an active point's Vtol comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Vtol {
+    Constant(f64),
+    Band(usize),
+}
+
+/// A point where V = Vtol is imposed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Point {
+    omega: Coord,
+    zeta: Coord,
+    vtol: Vtol,
+    /// Band limits of the free coordinates: (ω_lo, ω_hi, ζ_lo, ζ_hi).
+    bounds: (f64, f64, f64, f64),
+    /// V/Vtol on the grid solution (for ordering).
+    grid_ratio: f64,
+}
+
+/// One scalar equation of c(y) = 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Con {
+    /// Σ A = 1.
+    Sum,
+    /// A component of the k-th moment at a zero constraint, divided by `scale`.
+    Moment {
+        zero: usize,
+        order: u32,
+        part: usize,
+        scale: f64,
+    },
+    /// A_i = bound (`upper` says which bound; an inequality in disguise).
+    Bound {
+        index: usize,
+        value: f64,
+        upper: bool,
+    },
+    /// V/Vtol − 1 = 0 at point p (an inequality in disguise).
+    Limit(usize),
+    /// ∂ ln(V/Vtol)/∂ω = 0 (coord 0) or ∂/∂ζ = 0 (coord 1) at point p.
+    Stationary { point: usize, coord: usize },
+}
+
+/// The unknowns and equations of one Newton solve.
+#[derive(Debug, Clone)]
+struct Setup<'a> {
+    norm: &'a NormalizedProblem,
+    /// Number of impulses m (t₀ = 0 fixed; y = [t₁..t_{m−1}, A₀..A_{m−1}, extra]).
+    m: usize,
+    points: Vec<Point>,
+    cons: Vec<Con>,
+    n: usize,
+}
+
+impl Setup<'_> {
+    fn impulses(&self, y: &[f64]) -> Vec<Impulse> {
+        let m = self.m;
+        (0..m)
+            .map(|i| Impulse {
+                time: if i == 0 { 0.0 } else { y[i - 1] },
+                amplitude: y[m - 1 + i],
+            })
+            .collect()
+    }
+
+    fn coord(&self, c: Coord, y: &[f64]) -> f64 {
+        match c {
+            Coord::Fixed(v) => v,
+            Coord::Free(i) => y[i],
+        }
+    }
+
+    fn vtol_of(&self, p: &Point, omega: f64) -> (f64, f64) {
+        match p.vtol {
+            Vtol::Constant(v) => (v, 0.0),
+            Vtol::Band(b) => {
+                let band = &self.norm.bands[b];
+                let h = 1e-7 * omega.abs().max(1e-3);
+                let slope = (band.vtol(omega + h) - band.vtol(omega - h)) / (2.0 * h);
+                (band.vtol(omega), slope)
+            }
+        }
+    }
+
+    /// c(y).
+    fn residuals(&self, y: &[f64]) -> Vec<f64> {
+        let imps = self.impulses(y);
+        let t_n = imps.last().map_or(0.0, |i| i.time);
+        self.cons
+            .iter()
+            .map(|con| match *con {
+                Con::Sum => imps.iter().map(|i| i.amplitude).sum::<f64>() - 1.0,
+                Con::Moment {
+                    zero,
+                    order,
+                    part,
+                    scale,
+                } => {
+                    let z = &self.norm.zeros[zero];
+                    vibration_moment(&imps, z.omega, z.zeta, order)[part] / scale
+                }
+                Con::Bound { index, value, .. } => imps[index].amplitude - value,
+                Con::Limit(p) => {
+                    let pt = &self.points[p];
+                    let (w, z) = (self.coord(pt.omega, y), self.coord(pt.zeta, y));
+                    ratio(&imps, w, z, self.vtol_of(pt, w).0) - 1.0
+                }
+                Con::Stationary { point, coord } => {
+                    let pt = &self.points[point];
+                    let (w, z) = (self.coord(pt.omega, y), self.coord(pt.zeta, y));
+                    log_slope(&imps, t_n, w, z, coord, self.vtol_of(pt, w))
+                }
+            })
+            .collect()
+    }
+
+    /// Central-difference Jacobian of c.
+    fn jacobian(&self, y: &[f64]) -> DMatrix<f64> {
+        let mut j = DMatrix::zeros(self.cons.len(), self.n);
+        let mut yp = y.to_vec();
+        for col in 0..self.n {
+            let h = JACOBIAN_STEP * y[col].abs().max(1.0);
+            yp[col] = y[col] + h;
+            let rp = self.residuals(&yp);
+            yp[col] = y[col] - h;
+            let rm = self.residuals(&yp);
+            yp[col] = y[col];
+            for (row, (a, b)) in rp.iter().zip(&rm).enumerate() {
+                j[(row, col)] = (a - b) / (2.0 * h);
+            }
+        }
+        j
+    }
+
+    /// Index in y of the duration t_{m−1}.
+    fn duration_index(&self) -> usize {
+        self.m - 2
+    }
+
+    /// Whether y is a valid point: times strictly increasing and positive, free coordinates
+    /// inside their ranges.
+    fn valid(&self, y: &[f64]) -> bool {
+        if y.iter().any(|v| !v.is_finite()) {
+            return false;
+        }
+        let mut last = 0.0;
+        for &t in &y[..self.m - 1] {
+            if t <= last {
+                return false;
+            }
+            last = t;
+        }
+        for p in &self.points {
+            let (wl, wh, zl, zh) = p.bounds;
+            if let Coord::Free(i) = p.omega {
+                if y[i] < wl || y[i] > wh {
+                    return false;
+                }
+            }
+            if let Coord::Free(i) = p.zeta {
+                if y[i] < zl || y[i] > zh {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}
+
+/// ∂ ln(V/Vtol) / ∂ω (coord 0) or ∂ ln V / ∂ζ (coord 1), scaled to O(1), from the moments M₀, M₁
+/// of eq. 11: with M = M₀ as a complex number, dM/dω = −ζ t_n M₀ + (ζ + i√(1−ζ²)) M₁ and
+/// dM/dζ = −ω t_n M₀ + ω(1 − iζ/√(1−ζ²)) M₁ (differentiating e^{−ζω(t_n−t)} e^{iω√(1−ζ²) t}).
+fn log_slope(
+    imps: &[Impulse],
+    t_n: f64,
+    omega: f64,
+    zeta: f64,
+    coord: usize,
+    (vtol, vtol_slope): (f64, f64),
+) -> f64 {
+    let [c0, s0] = vibration_moment(imps, omega, zeta, 0);
+    let [c1, s1] = vibration_moment(imps, omega, zeta, 1);
+    let root = (1.0 - zeta * zeta).sqrt();
+    let (dc, ds) = if coord == 0 {
+        (
+            -zeta * t_n * c0 + zeta * c1 - root * s1,
+            -zeta * t_n * s0 + zeta * s1 + root * c1,
+        )
+    } else {
+        let q = zeta / root;
+        (
+            omega * (-t_n * c0 + c1 + q * s1),
+            omega * (-t_n * s0 + s1 - q * c1),
+        )
+    };
+    let v2 = (c0 * c0 + s0 * s0).max(1e-300);
+    let dlnv = (c0 * dc + s0 * ds) / v2;
+    let scale = if coord == 0 {
+        t_n.max(1.0)
+    } else {
+        (omega * t_n).max(1.0)
+    };
+    if coord == 0 {
+        (dlnv - vtol_slope / vtol) / scale
+    } else {
+        dlnv / scale
+    }
+}
+
+/// Result of the inner solve: y and the multipliers of c.
+struct Solved {
+    y: Vec<f64>,
+    lambda: Vec<f64>,
+}
+
+/// The linear algebra of one iterate: the pseudo-inverse of the Jacobian, a basis of its null
+/// space, and the least-squares multipliers.
+struct Linearization {
+    /// Number of unknowns.
+    n: usize,
+    /// Rows of Vᵀ and columns of U over the numerical range, with the singular values.
+    range: Vec<(DVector<f64>, DVector<f64>, f64)>,
+    /// Orthonormal basis of the null space of J.
+    null: Vec<DVector<f64>>,
+    /// Multipliers λ with Jᵀλ ≈ ∇t_n.
+    lambda: DVector<f64>,
+}
+
+impl Linearization {
+    fn new(jac: DMatrix<f64>, grad_f: &DVector<f64>) -> Option<Self> {
+        let n = jac.ncols();
+        let svd = jac.svd(true, true);
+        let (u, vt) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
+        let smax = svd.singular_values.iter().fold(0.0_f64, |a, &b| a.max(b));
+        let cut = 1e-10 * smax.max(1e-300);
+        let mut range = Vec::new();
+        let mut lambda = DVector::zeros(u.nrows());
+        for k in 0..svd.singular_values.len() {
+            let s = svd.singular_values[k];
+            if s > cut {
+                let uk = u.column(k).into_owned();
+                let vk = vt.row(k).transpose();
+                lambda += &uk * (vk.dot(grad_f) / s);
+                range.push((vk, uk, s));
+            }
+        }
+        // Unit vectors with the range of Jᵀ (and earlier basis vectors) projected out.
+        let mut null: Vec<DVector<f64>> = Vec::new();
+        for e in 0..n {
+            if null.len() + range.len() >= n {
+                break;
+            }
+            let mut v = DVector::zeros(n);
+            v[e] = 1.0;
+            for r in range.iter().map(|r| &r.0).chain(null.iter()) {
+                let d = r.dot(&v);
+                v -= r * d;
+            }
+            let norm = v.norm();
+            if norm > 1e-6 {
+                null.push(v / norm);
+            }
+        }
+        Some(Linearization {
+            n,
+            range,
+            null,
+            lambda,
+        })
+    }
+
+    /// The least-norm δ with J δ = −c.
+    fn restore(&self, c: &DVector<f64>) -> DVector<f64> {
+        let mut dy = DVector::zeros(self.n);
+        for (vk, uk, s) in &self.range {
+            dy -= vk * (uk.dot(c) / s);
+        }
+        dy
+    }
+}
+
+/// Reduced-Hessian SQP for min t_n s.t. c(y) = 0, from y0.
+///
+/// Far from c = 0 it takes Gauss–Newton steps on c alone (line search on ‖c‖₁). Near it, each
+/// step is the Gauss–Newton correction plus a Newton step on t_n in the null space of J (the
+/// reduced Hessian of the Lagrangian by finite differences, made positive definite, the step
+/// capped at [`MAX_NULL_STEP`]); the trial point is pulled back onto c = 0 by a few chord
+/// iterations with the same Jacobian before t_n is compared, which keeps the steps long on
+/// curved constraint sets.
+fn sqp(setup: &Setup, y0: Vec<f64>) -> Option<Solved> {
+    let n = setup.n;
+    let di = setup.duration_index();
+    let mut grad_f = DVector::zeros(n);
+    grad_f[di] = 1.0;
+    let mut y = y0;
+    if !setup.valid(&y) {
+        return None;
+    }
+    let infeasibility = |c: &[f64]| c.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+    let (mut best_c, mut since_best) = (f64::INFINITY, 0);
+    for _ in 0..MAX_NEWTON_ITERATIONS {
+        let c = DVector::from_vec(setup.residuals(&y));
+        let lin = Linearization::new(setup.jacobian(&y), &grad_f)?;
+        let gz: Vec<f64> = lin.null.iter().map(|z| z.dot(&grad_f)).collect();
+        let c_max = c.amax();
+        let gz_max = gz.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        if c_max < 0.5 * best_c {
+            (best_c, since_best) = (c_max, 0);
+        } else if c_max > RESTORATION_THRESHOLD {
+            since_best += 1;
+            if since_best >= STALL_ITERATIONS {
+                return None; // an inconsistent system: Gauss–Newton is stuck in least squares
+            }
+        }
+        if c_max <= RESIDUAL_TOLERANCE && gz_max <= GRADIENT_TOLERANCE {
+            return Some(Solved {
+                y,
+                lambda: lin.lambda.iter().copied().collect(),
+            });
+        }
+        let dy_range = lin.restore(&c);
+        let step_to = |dy: &DVector<f64>, alpha: f64| -> Vec<f64> {
+            y.iter()
+                .zip(dy.iter())
+                .map(|(a, b)| a + alpha * b)
+                .collect()
+        };
+
+        if c_max > RESTORATION_THRESHOLD || lin.null.is_empty() {
+            // Gauss–Newton on c, line search on ‖c‖.
+            let mut accepted = None;
+            let mut alpha = 1.0;
+            for _ in 0..30 {
+                let trial = step_to(&dy_range, alpha);
+                if setup.valid(&trial) && infeasibility(&setup.residuals(&trial)) < c_max {
+                    accepted = Some(trial);
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            match accepted {
+                Some(t) => y = t,
+                None if c_max <= 1e3 * RESIDUAL_TOLERANCE && gz_max <= GRADIENT_TOLERANCE => {
+                    return Some(Solved {
+                        y,
+                        lambda: lin.lambda.iter().copied().collect(),
+                    })
+                }
+                None => return None,
+            }
+            continue;
+        }
+
+        // Reduced Hessian of the Lagrangian L = t_n − λ·c along the null space (t_n is linear).
+        let lag = |yy: &[f64]| -> f64 {
+            let r = setup.residuals(yy);
+            -r.iter()
+                .zip(lin.lambda.iter())
+                .map(|(a, b)| a * b)
+                .sum::<f64>()
+        };
+        let nz = lin.null.len();
+        let mut hz = DMatrix::zeros(nz, nz);
+        let h = HESSIAN_STEP;
+        let shifted = |a: &DVector<f64>, b: &DVector<f64>, sa: f64, sb: f64| -> Vec<f64> {
+            y.iter()
+                .enumerate()
+                .map(|(i, &v)| v + h * (sa * a[i] + sb * b[i]))
+                .collect()
+        };
+        for p in 0..nz {
+            for q in p..nz {
+                let (a, b) = (&lin.null[p], &lin.null[q]);
+                let val = (lag(&shifted(a, b, 1.0, 1.0))
+                    - lag(&shifted(a, b, 1.0, -1.0))
+                    - lag(&shifted(a, b, -1.0, 1.0))
+                    + lag(&shifted(a, b, -1.0, -1.0)))
+                    / (4.0 * h * h);
+                hz[(p, q)] = val;
+                hz[(q, p)] = val;
+            }
+        }
+        // Positive definite (a minimum, not a saddle): eigenvalues by magnitude, floored.
+        let eig = hz.symmetric_eigen();
+        let emax = eig
+            .eigenvalues
+            .iter()
+            .fold(0.0_f64, |a, &b| a.max(b.abs()))
+            .max(1e-6);
+        let mut pz = DVector::zeros(nz);
+        for k in 0..nz {
+            let e = eig.eigenvalues[k].abs().max(1e-6 * emax);
+            let vk = eig.eigenvectors.column(k);
+            let g: f64 = vk.iter().zip(&gz).map(|(a, b)| a * b).sum();
+            pz -= vk * (g / e);
+        }
+        let mut null_step = DVector::zeros(n);
+        for (k, z) in lin.null.iter().enumerate() {
+            null_step += z * pz[k];
+        }
+        let big = null_step.amax();
+        if big > MAX_NULL_STEP {
+            null_step *= MAX_NULL_STEP / big;
+        }
+
+        // A trial point: the Gauss–Newton step plus α times the null-space step, pulled back
+        // onto c = 0 with the current Jacobian (chord iterations).
+        let trial_at = |alpha: f64| -> Option<Vec<f64>> {
+            let dy = &dy_range + &null_step * alpha;
+            let mut trial = step_to(&dy, 1.0);
+            for _ in 0..4 {
+                if !setup.valid(&trial) {
+                    return None;
+                }
+                let ct = DVector::from_vec(setup.residuals(&trial));
+                if ct.amax() <= RESIDUAL_TOLERANCE {
+                    break;
+                }
+                let corr = lin.restore(&ct);
+                for (t, d) in trial.iter_mut().zip(corr.iter()) {
+                    *t += d;
+                }
+            }
+            let ok = setup.valid(&trial)
+                && infeasibility(&setup.residuals(&trial)) <= c_max.max(RESIDUAL_TOLERANCE);
+            ok.then_some(trial)
+        };
+        // The restored point without the null-space step is the baseline the step must beat:
+        // making c = 0 exact may itself cost some duration.
+        let base = trial_at(0.0);
+        let mut accepted = None;
+        let mut alpha = 1.0;
+        for _ in 0..30 {
+            if let Some(trial) = trial_at(alpha) {
+                let beats = match &base {
+                    Some(b) => trial[di] < b[di],
+                    None => trial[di] < y[di],
+                };
+                if beats {
+                    accepted = Some(trial);
+                    break;
+                }
+            }
+            alpha *= 0.5;
+        }
+        match accepted.or(base.filter(|_| c_max > RESIDUAL_TOLERANCE)) {
+            Some(t) => y = t,
+            None => {
+                // No decrease found: converged as far as rounding allows, or stuck.
+                if c_max <= 1e3 * RESIDUAL_TOLERANCE && gz_max <= 1e3 * GRADIENT_TOLERANCE {
+                    return Some(Solved {
+                        y,
+                        lambda: lin.lambda.iter().copied().collect(),
+                    });
+                }
+                return None;
+            }
+        }
+    }
+    None
+}
+
+/// The state of the active-set loop: impulses and active points.
+struct Active {
+    impulses: Vec<Impulse>,
+    points: Vec<PointSpec>,
+    bounds: Vec<(usize, bool)>,
+}
+
+/// An active point before it is given unknowns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct PointSpec {
+    omega: f64,
+    zeta: f64,
+    omega_free: bool,
+    zeta_free: bool,
+    vtol: Vtol,
+    bounds: (f64, f64, f64, f64),
+    grid_ratio: f64,
+}
+
+impl PointSpec {
+    fn from_peak(norm: &NormalizedProblem, p: &Peak) -> Self {
+        let b = &norm.bands[p.band];
+        PointSpec {
+            omega: p.omega,
+            zeta: p.zeta,
+            omega_free: p.omega_free,
+            zeta_free: p.zeta_free,
+            vtol: Vtol::Band(p.band),
+            bounds: (b.omega_lo, b.omega_hi, b.zeta_lo, b.zeta_hi),
+            grid_ratio: p.ratio,
+        }
+    }
+}
+
+fn build<'a>(norm: &'a NormalizedProblem, active: &Active) -> (Setup<'a>, Vec<f64>) {
+    let m = active.impulses.len();
+    let mut y: Vec<f64> = active.impulses[1..].iter().map(|i| i.time).collect();
+    y.extend(active.impulses.iter().map(|i| i.amplitude));
+    let t_n = active.impulses.last().map_or(1.0, |i| i.time).max(1e-9);
+    let mut cons = vec![Con::Sum];
+    for (zi, z) in norm.zeros.iter().enumerate() {
+        for order in 0..=z.derivatives {
+            for part in 0..2 {
+                cons.push(Con::Moment {
+                    zero: zi,
+                    order,
+                    part,
+                    scale: t_n.powi(order as i32),
+                });
+            }
+        }
+    }
+    for &(index, upper) in &active.bounds {
+        let value = if upper {
+            norm.amplitude_max
+        } else {
+            norm.amplitude_min
+        };
+        cons.push(Con::Bound {
+            index,
+            value,
+            upper,
+        });
+    }
+    let mut points = Vec::new();
+    for (pi, spec) in active.points.iter().enumerate() {
+        let omega = if spec.omega_free {
+            y.push(spec.omega);
+            Coord::Free(y.len() - 1)
+        } else {
+            Coord::Fixed(spec.omega)
+        };
+        let zeta = if spec.zeta_free {
+            y.push(spec.zeta);
+            Coord::Free(y.len() - 1)
+        } else {
+            Coord::Fixed(spec.zeta)
+        };
+        points.push(Point {
+            omega,
+            zeta,
+            vtol: spec.vtol,
+            bounds: spec.bounds,
+            grid_ratio: spec.grid_ratio,
+        });
+        cons.push(Con::Limit(pi));
+        if spec.omega_free {
+            cons.push(Con::Stationary {
+                point: pi,
+                coord: 0,
+            });
+        }
+        if spec.zeta_free {
+            cons.push(Con::Stationary {
+                point: pi,
+                coord: 1,
+            });
+        }
+    }
+    let n = y.len();
+    (
+        Setup {
+            norm,
+            m,
+            points,
+            cons,
+            n,
+        },
+        y,
+    )
+}
+
+/// Number of unknowns minus equations for an active set (negative: overdetermined).
+fn freedom(norm: &NormalizedProblem, active: &Active) -> i64 {
+    let m = active.impulses.len() as i64;
+    let mut unknowns = 2 * m - 1;
+    let mut equations = 1 + active.bounds.len() as i64;
+    for z in &norm.zeros {
+        equations += 2 * (z.derivatives as i64 + 1);
+    }
+    for p in &active.points {
+        unknowns += i64::from(p.omega_free) + i64::from(p.zeta_free);
+        equations += 1 + i64::from(p.omega_free) + i64::from(p.zeta_free);
+    }
+    unknowns - equations
+}
+
+/// Polishes the grid solution; `None` when no exact solution with the same structure is found.
+///
+/// The first structure tried is one impulse per cluster of the grid solution. A cluster
+/// spread over more grid points than one impulse between two points explains may be two
+/// impulses close together: if the first structure fails, the widest clusters are split in two
+/// (same amplitude sum, mean time and spread).
+pub(crate) fn polish(norm: &NormalizedProblem, grid: &GridSolution) -> Option<Vec<Impulse>> {
+    let found = clusters(grid);
+    let raw: Vec<Impulse> = grid
+        .times
+        .iter()
+        .zip(&grid.amplitudes)
+        .map(|(&time, &amplitude)| Impulse { time, amplitude })
+        .collect();
+    let mut wide: Vec<usize> = (0..found.len())
+        .filter(|&i| found[i].spacing > 0.0 && found[i].spread > 0.55 * found[i].spacing)
+        .collect();
+    wide.sort_by(|&a, &b| {
+        let r = |c: &Cluster| c.spread / c.spacing;
+        r(&found[b]).total_cmp(&r(&found[a]))
+    });
+    for splits in 0..=wide.len().min(MAX_SPLITS) {
+        let mut start = Vec::new();
+        for (i, c) in found.iter().enumerate() {
+            if wide[..splits].contains(&i) {
+                start.push(Impulse {
+                    time: c.time - c.spread,
+                    amplitude: 0.5 * c.amplitude,
+                });
+                start.push(Impulse {
+                    time: c.time + c.spread,
+                    amplitude: 0.5 * c.amplitude,
+                });
+            } else {
+                start.push(Impulse {
+                    time: c.time,
+                    amplitude: c.amplitude,
+                });
+            }
+        }
+        if start.len() < 2 {
+            return None;
+        }
+        let t0 = start[0].time;
+        for imp in &mut start {
+            imp.time = (imp.time - t0).max(0.0);
+        }
+        if let Some(result) = polish_from(norm, &raw, start) {
+            // Every grid solution is itself a feasible shaper, so with exact (sampled)
+            // constraints a longer result is a worse local optimum: reject it. (With bands the
+            // grid only saw samples and may be shorter than any shaper meeting the whole band.)
+            let t_n = result.last().map_or(0.0, |i| i.time);
+            if !norm.bands.is_empty() || t_n <= grid.duration * (1.0 + 1e-9) {
+                return Some(result);
+            }
+        }
+    }
+    None
+}
+
+/// The active-set loop from one starting structure.
+fn polish_from(
+    norm: &NormalizedProblem,
+    raw: &[Impulse],
+    start: Vec<Impulse>,
+) -> Option<Vec<Impulse>> {
+    let raw = raw.to_vec();
+
+    // Candidate active points, ranked by V/Vtol on the grid solution.
+    let mut candidates: Vec<PointSpec> = norm
+        .limits
+        .iter()
+        .map(|l| PointSpec {
+            omega: l.omega,
+            zeta: l.zeta,
+            omega_free: false,
+            zeta_free: false,
+            vtol: Vtol::Constant(l.vtol),
+            bounds: (l.omega, l.omega, l.zeta, l.zeta),
+            grid_ratio: ratio(&raw, l.omega, l.zeta, l.vtol),
+        })
+        .collect();
+    for (b, band) in norm.bands.iter().enumerate() {
+        candidates.extend(
+            band_peaks(&raw, band, b, None)
+                .iter()
+                .map(|p| PointSpec::from_peak(norm, p)),
+        );
+    }
+    candidates.sort_by(|a, b| b.grid_ratio.total_cmp(&a.grid_ratio));
+    let top = candidates.first().map_or(0.0, |c| c.grid_ratio);
+
+    let range = norm.amplitude_max - norm.amplitude_min;
+    let mut active = Active {
+        bounds: start
+            .iter()
+            .enumerate()
+            .filter_map(|(i, imp)| {
+                if norm.amplitude_min != 0.0
+                    && (imp.amplitude - norm.amplitude_min).abs() < 0.02 * range
+                {
+                    Some((i, false))
+                } else if (norm.amplitude_max - imp.amplitude).abs() < 0.02 * range {
+                    Some((i, true))
+                } else {
+                    None
+                }
+            })
+            .collect(),
+        impulses: start,
+        points: Vec::new(),
+    };
+    // The grid solution sits at a level ≤ 1 at its samples, but a band's humps between samples
+    // may exceed 1: measure nearness from min(top, 1).
+    for c in &candidates {
+        if c.grid_ratio >= top.min(1.0) - ACTIVE_BAND && freedom(norm, &active) > 0 {
+            active.points.push(*c);
+        }
+    }
+
+    let mut dropped_from: Option<Vec<PointSpec>> = None;
+    let mut drops = 0;
+    for _ in 0..MAX_ACTIVE_SET_ROUNDS {
+        // (More equations than unknowns is allowed: degenerate but consistent systems, e.g.
+        // a single-mode ZVD that also cancels a mode at an odd multiple of its frequency, are
+        // solved by Gauss–Newton in the least-squares sense; inconsistent ones fail there.)
+        if active.impulses.len() < 2 {
+            return None;
+        }
+        let (setup, y0) = build(norm, &active);
+        let solved = sqp(&setup, y0);
+        let Some(solved) = solved else {
+            // No exact solution with this structure: if there is room for another constraint,
+            // activate the next candidate (by V/Vtol on the grid solution) and try again.
+            let next = candidates
+                .iter()
+                .find(|c| c.grid_ratio >= 0.5 * top && !active.points.contains(c));
+            match next {
+                Some(c) if freedom(norm, &active) > 0 => {
+                    active.points.push(*c);
+                    continue;
+                }
+                _ => {}
+            }
+            // Too many (inconsistent) constraints: leave one of them out, in turn, starting
+            // from the one the grid solution held furthest below Vtol.
+            let base = dropped_from.get_or_insert_with(|| active.points.clone());
+            let mut order: Vec<usize> = (0..base.len()).collect();
+            order.sort_by(|&a, &b| base[a].grid_ratio.total_cmp(&base[b].grid_ratio));
+            match order.get(drops) {
+                Some(&k) if drops < MAX_DROPS => {
+                    let mut points = base.clone();
+                    points.remove(k);
+                    active.points = points;
+                    drops += 1;
+                    continue;
+                }
+                _ => return None,
+            }
+        };
+        let imps = setup.impulses(&solved.y);
+
+        // Two impulses that converged onto one time are one impulse: merge and solve again.
+        let t_n = imps.last().map_or(0.0, |i| i.time);
+        if let Some(k) = (1..imps.len()).find(|&k| imps[k].time - imps[k - 1].time < 1e-7 * t_n) {
+            let mut merged = imps.clone();
+            let (a, b) = (merged[k - 1], merged[k]);
+            let sum = a.amplitude + b.amplitude;
+            merged[k - 1] = Impulse {
+                time: if sum != 0.0 {
+                    (a.time * a.amplitude + b.time * b.amplitude) / sum
+                } else {
+                    a.time
+                },
+                amplitude: sum,
+            };
+            merged.remove(k);
+            active.impulses = merged;
+            active.bounds = shift_bounds(&active.bounds, k);
+            update_points(&mut active, &setup, &solved.y);
+            continue;
+        }
+
+        // Amplitudes out of bounds: drop an impulse that wants to vanish (lower bound 0),
+        // otherwise pin it to the bound.
+        let tol = 1e-12;
+        if let Some((i, imp)) = imps
+            .iter()
+            .enumerate()
+            .filter(|(_, imp)| {
+                imp.amplitude < norm.amplitude_min - tol || imp.amplitude > norm.amplitude_max + tol
+            })
+            .max_by(|a, b| {
+                let ex = |x: &Impulse| {
+                    (norm.amplitude_min - x.amplitude).max(x.amplitude - norm.amplitude_max)
+                };
+                ex(a.1).total_cmp(&ex(b.1))
+            })
+        {
+            let upper = imp.amplitude > norm.amplitude_max;
+            active.impulses = imps.clone();
+            if !upper && norm.amplitude_min == 0.0 {
+                active.impulses.remove(i);
+                active.bounds = shift_bounds(&active.bounds, i);
+                if i == 0 {
+                    let t0 = active.impulses.first().map_or(0.0, |x| x.time);
+                    for x in &mut active.impulses {
+                        x.time -= t0;
+                    }
+                }
+            } else {
+                active.bounds.push((i, upper));
+            }
+            update_points(&mut active, &setup, &solved.y);
+            continue;
+        }
+
+        // Multipliers of the inequalities: with L = t_n − λ·c, an inequality c ≤ 0 needs λ ≤ 0
+        // (V/Vtol − 1 ≤ 0; A − A_max ≤ 0) and c = A − A_min ≥ 0 needs λ ≥ 0.
+        let lmax = solved.lambda.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        let mut worst: Option<(usize, f64)> = None;
+        for (k, con) in setup.cons.iter().enumerate() {
+            let wrong = match con {
+                Con::Limit(_) | Con::Bound { upper: true, .. } => solved.lambda[k],
+                Con::Bound { upper: false, .. } => -solved.lambda[k],
+                _ => continue,
+            };
+            if wrong > 1e-7 * lmax.max(1e-12) && worst.is_none_or(|(_, w)| wrong > w) {
+                worst = Some((k, wrong));
+            }
+        }
+        if let Some((k, _)) = worst {
+            active.impulses = imps;
+            update_points(&mut active, &setup, &solved.y);
+            match setup.cons[k] {
+                Con::Limit(p) => {
+                    active.points.remove(p);
+                }
+                Con::Bound { index, upper, .. } => {
+                    active.bounds.retain(|&b| b != (index, upper));
+                }
+                _ => {}
+            }
+            continue;
+        }
+
+        // Constraints the result violates: add the worst one.
+        let mut worst_violation: Option<(PointSpec, f64)> = None;
+        for l in &norm.limits {
+            let r = ratio(&imps, l.omega, l.zeta, l.vtol);
+            if r > 1.0 + CHECK_TOLERANCE * 0.1 && worst_violation.is_none_or(|(_, w)| r > w) {
+                worst_violation = Some((
+                    PointSpec {
+                        omega: l.omega,
+                        zeta: l.zeta,
+                        omega_free: false,
+                        zeta_free: false,
+                        vtol: Vtol::Constant(l.vtol),
+                        bounds: (l.omega, l.omega, l.zeta, l.zeta),
+                        grid_ratio: r,
+                    },
+                    r,
+                ));
+            }
+        }
+        for (b, band) in norm.bands.iter().enumerate() {
+            for p in band_peaks(&imps, band, b, None) {
+                if p.ratio > 1.0 + CHECK_TOLERANCE * 0.1
+                    && worst_violation.is_none_or(|(_, w)| p.ratio > w)
+                {
+                    worst_violation = Some((PointSpec::from_peak(norm, &p), p.ratio));
+                }
+            }
+        }
+        if let Some((spec, _)) = worst_violation {
+            active.impulses = imps;
+            update_points(&mut active, &setup, &solved.y);
+            // Free coordinates of an existing point may have slid onto the new one's place.
+            active.points.push(spec);
+            continue;
+        }
+        return Some(imps);
+    }
+    None
+}
+
+fn shift_bounds(bounds: &[(usize, bool)], removed: usize) -> Vec<(usize, bool)> {
+    bounds
+        .iter()
+        .filter(|&&(i, _)| i != removed)
+        .map(|&(i, u)| (if i > removed { i - 1 } else { i }, u))
+        .collect()
+}
+
+/// Copies the solved free coordinates back into the point specs.
+fn update_points(active: &mut Active, setup: &Setup, y: &[f64]) {
+    for (spec, pt) in active.points.iter_mut().zip(&setup.points) {
+        spec.omega = setup.coord(pt.omega, y);
+        spec.zeta = setup.coord(pt.zeta, y);
+    }
+}
+
+/// Makes the equalities (Σ A = 1 and the zero moments) hold exactly at fixed times by the
+/// smallest change of the amplitudes (least-norm correction through the pseudo-inverse).
+pub(crate) fn project_equalities(norm: &NormalizedProblem, impulses: &mut [Impulse]) {
+    let n = impulses.len();
+    let t_n = impulses.last().map_or(0.0, |i| i.time);
+    let mut rows: Vec<Vec<f64>> = vec![vec![1.0; n]];
+    let mut rhs = vec![1.0];
+    for z in &norm.zeros {
+        for order in 0..=z.derivatives {
+            for part in 0..2 {
+                let row: Vec<f64> = impulses
+                    .iter()
+                    .map(|imp| {
+                        let p = impulse_phasor(imp.time, t_n, z.omega, z.zeta);
+                        p[part] * imp.time.powi(order as i32)
+                    })
+                    .collect();
+                let scale = row.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+                if scale > 0.0 {
+                    rows.push(row.iter().map(|v| v / scale).collect());
+                    rhs.push(0.0);
+                }
+            }
+        }
+    }
+    let e = DMatrix::from_fn(rows.len(), n, |r, c| rows[r][c]);
+    let a = DVector::from_iterator(n, impulses.iter().map(|i| i.amplitude));
+    let residual = DVector::from_vec(rhs) - &e * &a;
+    let svd = (&e * e.transpose()).svd(true, true);
+    if let Ok(w) = svd.solve(&residual, 1e-12) {
+        let delta = e.transpose() * w;
+        for (imp, d) in impulses.iter_mut().zip(delta.iter()) {
+            imp.amplitude += d;
+        }
+    }
+}

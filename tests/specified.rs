@@ -1,0 +1,533 @@
+//! Specified-insensitivity (SI) shapers (`family: "si"`) against the literature, closed forms
+//! and an independent evaluation of V (superposition of impulse responses in time).
+//! Two modes of constraint: "sampled" (V ≤ Vtol only at listed frequencies, as the papers do)
+//! and "whole band" (the default: V ≤ Vtol everywhere on the band, verified densely).
+//! Runs natively (`cargo test`) and in wasm (`wasm-pack test`).
+
+mod common;
+
+use common::{close, residual_by_superposition};
+use input_shaping::design::specified::SiSpec;
+use input_shaping::vibration::residual_vibration;
+use input_shaping::{design, DesignRequest, Error, Impulse, Mode, ModeSpec, Shaper};
+use std::f64::consts::PI;
+use wasm_bindgen_test::wasm_bindgen_test;
+
+fn mode(frequency_hz: f64, damping: f64) -> Vec<ModeSpec> {
+    vec![ModeSpec {
+        frequency_hz,
+        damping,
+    }]
+}
+
+fn si(spec: SiSpec, f: f64, z: f64) -> Shaper {
+    design(&spec.request(mode(f, z))).unwrap()
+}
+
+/// V by superposition at frequency `f` and damping `z`.
+fn v(s: &Shaper, f: f64, z: f64) -> f64 {
+    residual_by_superposition(s, &Mode::new(f, z).unwrap())
+}
+
+/// Largest V by superposition over `n` evenly spaced frequencies of [lo, hi] at damping `z`.
+fn max_v(s: &Shaper, lo: f64, hi: f64, z: f64, n: usize) -> f64 {
+    (0..n)
+        .map(|i| v(s, lo + (hi - lo) * i as f64 / (n - 1) as f64, z))
+        .fold(0.0, f64::max)
+}
+
+/// Peláez & Singhose 2002's example: 0.5 Hz, ζ = 0.002, Vtol = 5 %, I = 0.7, so the band is
+/// [0.325, 0.675] Hz.
+const PAPER_F: f64 = 0.5;
+const PAPER_Z: f64 = 0.002;
+/// Their eq. 7.
+const PAPER_T: [f64; 4] = [0.0, 0.9767, 1.9383, 2.9151];
+const PAPER_A: [f64; 4] = [0.156, 0.344, 0.344, 0.156];
+
+/// The paper samples "six versions of (6) at some specified frequencies (see Fig. 6)"; the
+/// figure, and so the frequencies, are not in the text we have. We take six evenly spaced over
+/// the band, edges included, as Singhose 2009 Fig. 8 draws them (a reconstruction).
+fn paper_samples() -> Vec<f64> {
+    (0..6).map(|i| 0.325 + 0.07 * i as f64).collect()
+}
+
+/// SAMPLED mode reproduces Peláez & Singhose 2002 eq. 7: four symmetric-looking impulses about
+/// 0.97 s apart. Agreement is to ~1 % of the duration: the paper's shaper is not itself a
+/// minimum of any sampling that includes its band edges (it leaves 7.4 % at 0.325 Hz, see the
+/// next test), so it cannot be matched exactly. The duration also matches an independent
+/// design of the same sampled problem, scipy SLSQP from random starts (benches/si_slsqp.py:
+/// 2.895073 s, t = [0, 0.96332, 1.93253, 2.89507], A = [0.16417, 0.3381, 0.33631, 0.16142]).
+#[wasm_bindgen_test(unsupported = test)]
+fn pelaez_singhose_2002_eq7_sampled_mode() {
+    let s = si(
+        SiSpec {
+            insensitivity: Some(0.7),
+            sample_frequencies_hz: Some(paper_samples()),
+            ..Default::default()
+        },
+        PAPER_F,
+        PAPER_Z,
+    );
+    assert_eq!(s.len(), 4);
+    for (imp, (t, a)) in s.impulses().iter().zip(PAPER_T.iter().zip(PAPER_A)) {
+        close(imp.time, *t, 0.025, "time vs eq. 7");
+        close(imp.amplitude, a, 0.01, "amplitude vs eq. 7");
+    }
+    close(s.duration(), 2.895073, 2e-6, "duration vs SLSQP");
+    let slsqp = [
+        (0.0, 0.16417),
+        (0.96332, 0.3381),
+        (1.93253, 0.33631),
+        (2.89507, 0.16142),
+    ];
+    for (imp, (t, a)) in s.impulses().iter().zip(slsqp) {
+        close(imp.time, t, 1e-5, "time vs SLSQP");
+        close(imp.amplitude, a, 1e-5, "amplitude vs SLSQP");
+    }
+    for f in paper_samples() {
+        assert!(v(&s, f, PAPER_Z) <= 0.05 * (1.0 + 1e-9), "V({f} Hz)");
+    }
+    // Sampled means sampled: between the samples V exceeds 5 %.
+    assert!(max_v(&s, 0.325, 0.675, PAPER_Z, 2000) > 0.05);
+}
+
+/// The paper's own shaper (eq. 7) leaves 7.4 % at the band's lower edge, 0.325 Hz, and 5.46 %
+/// at 0.60 Hz — it does not hold Vtol = 5 % over I = 0.7.
+#[wasm_bindgen_test(unsupported = test)]
+fn pelaez_singhose_2002_eq7_exceeds_vtol_on_its_band() {
+    let paper = Shaper::new(
+        PAPER_T
+            .iter()
+            .zip(PAPER_A)
+            .map(|(&time, amplitude)| Impulse { time, amplitude })
+            .collect(),
+    )
+    .unwrap();
+    close(v(&paper, 0.325, PAPER_Z), 0.074, 5e-4, "V(0.325 Hz)");
+    close(
+        residual_vibration(&paper, &Mode::new(0.325, PAPER_Z).unwrap()),
+        v(&paper, 0.325, PAPER_Z),
+        1e-12,
+        "eq. 11 vs superposition",
+    );
+    close(v(&paper, 0.6, PAPER_Z), 0.0546, 5e-4, "V(0.6 Hz)");
+}
+
+/// WHOLE-BAND mode (default) for the same request: V ≤ 5 % everywhere on [0.325, 0.675] Hz
+/// (checked here by superposition on 4001 frequencies), slightly longer than both the sampled
+/// design and the paper's shaper (which does not hold the bound).
+#[wasm_bindgen_test(unsupported = test)]
+fn pelaez_singhose_2002_whole_band_mode_holds_everywhere() {
+    let whole = si(
+        SiSpec {
+            insensitivity: Some(0.7),
+            ..Default::default()
+        },
+        PAPER_F,
+        PAPER_Z,
+    );
+    assert!(max_v(&whole, 0.325, 0.675, PAPER_Z, 4001) <= 0.05 * (1.0 + 1e-9));
+    assert!(whole.duration() > 2.895073 && whole.duration() > PAPER_T[3]);
+    assert!(whole.duration() < PAPER_T[3] * 1.02, "{}", whole.duration());
+    // Touches the bound: it is as short as it can be for this band.
+    assert!(max_v(&whole, 0.325, 0.675, PAPER_Z, 4001) > 0.0499);
+    close(whole.amplitude_sum(), 1.0, 1e-12, "Σ A");
+    assert!(whole.impulses().iter().all(|i| i.amplitude >= 0.0));
+}
+
+/// Singhose 2009 Fig. 11: EI shapers are nodes of the SI curve. At ζ = 0 the EI shaper
+/// [(1+V)/4, (1−V)/2, (1+V)/4] at [0, T/2, T] has V(f) = |(1−V)/2 + (1+V)/2·cos(πf/f_m)|, so
+/// its 5 % band edges solve cos(πr) = (3V−1)/(1+V): I = 2(1 − acos((3V−1)/(1+V))/π) = 0.3995
+/// ("0.4" in Fig. 7). SI with exactly that insensitivity is the EI shaper, one period long;
+/// with I = 0.4 it is a hair longer (about one period).
+#[wasm_bindgen_test(unsupported = test)]
+fn si_at_ei_insensitivity_is_the_ei_shaper() {
+    let vtol: f64 = 0.05;
+    let i_ei = 2.0 * (1.0 - ((3.0 * vtol - 1.0) / (1.0 + vtol)).acos() / PI);
+    close(i_ei, 0.3995, 1e-4, "EI insensitivity");
+    let s = si(
+        SiSpec {
+            insensitivity: Some(i_ei),
+            ..Default::default()
+        },
+        1.0,
+        0.0,
+    );
+    let want = [
+        (0.0, (1.0 + vtol) / 4.0),
+        (0.5, (1.0 - vtol) / 2.0),
+        (1.0, (1.0 + vtol) / 4.0),
+    ];
+    assert_eq!(s.len(), 3);
+    for (imp, (t, a)) in s.impulses().iter().zip(want) {
+        close(imp.time, t, 1e-7, "EI time");
+        close(imp.amplitude, a, 1e-7, "EI amplitude");
+    }
+    let s = si(
+        SiSpec {
+            insensitivity: Some(0.4),
+            ..Default::default()
+        },
+        1.0,
+        0.0,
+    );
+    assert!(
+        (1.0..1.01).contains(&s.duration()),
+        "I = 0.4: {} periods",
+        s.duration()
+    );
+    assert!(max_v(&s, 0.8, 1.2, 0.0, 2001) <= vtol * (1.0 + 1e-9));
+}
+
+/// Singhose 2009 Fig. 9 and 11: more insensitivity costs duration, monotonically; every design
+/// holds V ≤ Vtol over its band (superposition, 2001 frequencies).
+#[wasm_bindgen_test(unsupported = test)]
+fn longer_for_wider_bands() {
+    let mut last = 0.0;
+    for i in [0.1, 0.3, 0.5, 0.7, 0.9] {
+        let s = si(
+            SiSpec {
+                insensitivity: Some(i),
+                ..Default::default()
+            },
+            2.0,
+            0.03,
+        );
+        let (lo, hi) = (2.0 * (1.0 - i / 2.0), 2.0 * (1.0 + i / 2.0));
+        assert!(
+            max_v(&s, lo, hi, 0.03, 2001) <= 0.05 * (1.0 + 1e-9),
+            "I = {i}"
+        );
+        assert!(s.duration() > last, "I = {i}");
+        last = s.duration();
+    }
+}
+
+/// Singhose 2009 Fig. 10: robust over 0.7 … 1.3 Hz *and* ζ ∈ [0, 0.2]. V ≤ 5 % on a dense
+/// (f, ζ) grid, and the damping range costs duration over the same band at one damping.
+#[wasm_bindgen_test(unsupported = test)]
+fn frequency_and_damping_range_fig10() {
+    let s = si(
+        SiSpec {
+            band_hz: Some([0.7, 1.3]),
+            damping_range: Some([0.0, 0.2]),
+            ..Default::default()
+        },
+        1.0,
+        0.1,
+    );
+    for j in 0..=20 {
+        let z = 0.2 * j as f64 / 20.0;
+        assert!(
+            max_v(&s, 0.7, 1.3, z, 601) <= 0.05 * (1.0 + 1e-9),
+            "ζ = {z}"
+        );
+    }
+    let single = si(
+        SiSpec {
+            band_hz: Some([0.7, 1.3]),
+            ..Default::default()
+        },
+        1.0,
+        0.1,
+    );
+    assert!(s.duration() > single.duration());
+}
+
+/// Weighted design (`vtolProfile`): Vtol 2 % at the band's low end rising to 8 % at its top
+/// (Singhose 2009 §3.1: weight the lower frequencies more). V ≤ Vtol(f) everywhere, and the
+/// result differs from the constant-Vtol design.
+#[wasm_bindgen_test(unsupported = test)]
+fn weighted_vtol_profile() {
+    let profile = vec![[0.65, 0.02], [1.35, 0.08]];
+    let vtol_at = |f: f64| 0.02 + 0.06 * (f - 0.65) / 0.7;
+    let s = si(
+        SiSpec {
+            insensitivity: Some(0.7),
+            vtol_profile: Some(profile),
+            ..Default::default()
+        },
+        1.0,
+        0.0,
+    );
+    for k in 0..=2000 {
+        let f = 0.65 + 0.7 * k as f64 / 2000.0;
+        assert!(v(&s, f, 0.0) <= vtol_at(f) * (1.0 + 1e-9), "V({f} Hz)");
+    }
+    let flat = si(
+        SiSpec {
+            insensitivity: Some(0.7),
+            ..Default::default()
+        },
+        1.0,
+        0.0,
+    );
+    assert!((s.duration() - flat.duration()).abs() > 1e-3);
+    // Tighter where the weight is, looser at the top: the low end is held below 5 %.
+    assert!(max_v(&s, 0.65, 0.75, 0.0, 201) < 0.05);
+}
+
+/// Negative amplitudes allowed (amplitudeMin = −0.2): V ≤ Vtol still holds on the band, every
+/// impulse respects its bounds, and the shaper is shorter than the positive one.
+#[wasm_bindgen_test(unsupported = test)]
+fn negative_amplitudes_give_a_shorter_si() {
+    let spec = |amplitude_min: f64| SiSpec {
+        insensitivity: Some(0.5),
+        amplitude_min,
+        ..Default::default()
+    };
+    let positive = si(spec(0.0), 1.0, 0.0);
+    let negative = si(spec(-0.2), 1.0, 0.0);
+    assert!(negative.duration() < positive.duration());
+    assert!(negative.impulses().iter().any(|i| i.amplitude < 0.0));
+    assert!(negative
+        .impulses()
+        .iter()
+        .all(|i| (-0.2 - 1e-9..=1.0 + 1e-9).contains(&i.amplitude)));
+    close(negative.amplitude_sum(), 1.0, 1e-9, "Σ A");
+    assert!(max_v(&negative, 0.75, 1.25, 0.0, 2001) <= 0.05 * (1.0 + 1e-9));
+}
+
+/// Several modes: a band around each, designed together.
+#[wasm_bindgen_test(unsupported = test)]
+fn two_modes_two_bands() {
+    let modes = vec![
+        ModeSpec {
+            frequency_hz: 1.0,
+            damping: 0.02,
+        },
+        ModeSpec {
+            frequency_hz: 3.3,
+            damping: 0.01,
+        },
+    ];
+    let s = design(
+        &SiSpec {
+            insensitivity: Some(0.3),
+            ..Default::default()
+        }
+        .request(modes),
+    )
+    .unwrap();
+    assert!(max_v(&s, 0.85, 1.15, 0.02, 1001) <= 0.05 * (1.0 + 1e-9));
+    assert!(max_v(&s, 3.3 * 0.85, 3.3 * 1.15, 0.01, 1001) <= 0.05 * (1.0 + 1e-9));
+}
+
+/// Infeasible requests say why: too few impulses allowed, or too short a duration.
+#[wasm_bindgen_test(unsupported = test)]
+fn infeasible_requests_say_why() {
+    let base = SiSpec {
+        insensitivity: Some(0.7),
+        ..Default::default()
+    };
+    let err = design(
+        &SiSpec {
+            max_impulses: Some(3),
+            ..base.clone()
+        }
+        .request(mode(0.5, 0.002)),
+    )
+    .unwrap_err();
+    match err {
+        Error::Infeasible { reason } => {
+            assert!(reason.contains("maxImpulses = 3"), "{reason}");
+            assert!(reason.contains("4 impulses"), "{reason}");
+        }
+        e => panic!("expected Infeasible, got {e}"),
+    }
+    // The sampled design needs 2.895 s, the whole band 2.94 s: 2.5 s is not enough.
+    let err = design(
+        &SiSpec {
+            max_duration: Some(2.5),
+            ..base
+        }
+        .request(mode(0.5, 0.002)),
+    )
+    .unwrap_err();
+    match err {
+        Error::Infeasible { reason } => assert!(reason.contains("maxDuration"), "{reason}"),
+        e => panic!("expected Infeasible, got {e}"),
+    }
+}
+
+/// Bad parameters are errors naming the field as a JS user writes it.
+#[wasm_bindgen_test(unsupported = test)]
+fn bad_parameters_name_their_field() {
+    let cases: Vec<(SiSpec, &str)> = vec![
+        (SiSpec::default(), "insensitivity"),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                band_hz: Some([0.8, 1.2]),
+                ..Default::default()
+            },
+            "bandHz",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(-0.5),
+                ..Default::default()
+            },
+            "insensitivity",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(2.5),
+                ..Default::default()
+            },
+            "insensitivity",
+        ),
+        (
+            SiSpec {
+                band_hz: Some([1.2, 0.8]),
+                ..Default::default()
+            },
+            "bandHz",
+        ),
+        (
+            SiSpec {
+                band_hz: Some([0.0, 0.8]),
+                ..Default::default()
+            },
+            "bandHz[0]",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                vtol: 1.5,
+                ..Default::default()
+            },
+            "vtol",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                vtol: f64::NAN,
+                ..Default::default()
+            },
+            "vtol",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                damping_range: Some([0.1, 1.0]),
+                ..Default::default()
+            },
+            "dampingRange[1]",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                sample_frequencies_hz: Some(vec![0.9, 2.0]),
+                ..Default::default()
+            },
+            "sampleFrequenciesHz[1]",
+        ),
+        (
+            SiSpec {
+                sample_frequencies_hz: Some(vec![]),
+                ..Default::default()
+            },
+            "sampleFrequenciesHz",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                vtol_profile: Some(vec![[1.0, 0.05], [0.9, 0.05]]),
+                ..Default::default()
+            },
+            "vtolProfile[1][0]",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                vtol_profile: Some(vec![[1.0, 0.0]]),
+                ..Default::default()
+            },
+            "vtolProfile[0][1]",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                amplitude_min: 2.0,
+                ..Default::default()
+            },
+            "amplitudeMin",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                max_impulses: Some(0),
+                ..Default::default()
+            },
+            "maxImpulses",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                max_duration: Some(-1.0),
+                ..Default::default()
+            },
+            "maxDuration",
+        ),
+    ];
+    for (spec, field) in cases {
+        let err = design(&spec.clone().request(mode(1.0, 0.0))).unwrap_err();
+        assert_eq!(err.field(), Some(field), "{spec:?}: {err}");
+    }
+    // bandHz is one band: not with several modes.
+    let two = vec![
+        ModeSpec {
+            frequency_hz: 1.0,
+            damping: 0.0,
+        },
+        ModeSpec {
+            frequency_hz: 2.0,
+            damping: 0.0,
+        },
+    ];
+    let err = design(
+        &SiSpec {
+            band_hz: Some([0.8, 1.2]),
+            ..Default::default()
+        }
+        .request(two),
+    )
+    .unwrap_err();
+    assert_eq!(err.field(), Some("bandHz"));
+}
+
+/// The spec parses from JSON as a user writes it (camelCase), and the family is in the table.
+#[wasm_bindgen_test(unsupported = test)]
+fn si_spec_from_json() {
+    let request: DesignRequest = serde_json::from_str(
+        r#"{ "family": "si", "modes": [{ "frequencyHz": 0.5, "damping": 0.002 }],
+             "vtol": 0.05, "insensitivity": 0.7,
+             "sampleFrequenciesHz": [0.325, 0.395, 0.465, 0.535, 0.605, 0.675] }"#,
+    )
+    .unwrap();
+    assert_eq!(request.shaper.name(), "si");
+    let info = request.shaper.info().unwrap();
+    assert!(info.parameters.contains(&"sampleFrequenciesHz"));
+    close(
+        design(&request).unwrap().duration(),
+        2.895073,
+        2e-6,
+        "duration",
+    );
+    let parsed: DesignRequest = serde_json::from_str(
+        r#"{ "family": "si", "modes": [{ "frequencyHz": 1 }], "bandHz": [0.7, 1.3],
+             "dampingRange": [0, 0.2], "vtolProfile": [[0.7, 0.03], [1.3, 0.06]],
+             "amplitudeMin": -0.1, "amplitudeMax": 1.2, "maxImpulses": 9, "maxDuration": 4 }"#,
+    )
+    .unwrap();
+    match parsed.shaper {
+        input_shaping::ShaperSpec::Si(spec) => {
+            assert_eq!(spec.band_hz, Some([0.7, 1.3]));
+            assert_eq!(spec.damping_range, Some([0.0, 0.2]));
+            assert_eq!(spec.max_impulses, Some(9));
+            assert_eq!(spec.amplitude_min, -0.1);
+        }
+        other => panic!("parsed as {other:?}"),
+    }
+}
