@@ -104,7 +104,7 @@ function shaperCard(spec, k) {
       input = el('select', { id: `shaper-${k}-${name}`, dataset: { field: `shapers[${k}].${name}` } },
         ...options.map((o) => el('option', { value: o }, pinfo.kind === 'boolean' ? (o === 'true' ? 'yes' : 'no') : o)));
       input.value = formatParam(pinfo, spec[name]);
-    } else if (pinfo.kind === 'pairs') {
+    } else if (pinfo.kind === 'pairs' || pinfo.kind === 'points') {
       input = el('textarea', { id: `shaper-${k}-${name}`, rows: '4', dataset: { field: `shapers[${k}].${name}` } });
       input.value = formatParam(pinfo, spec[name]);
     } else {

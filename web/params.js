@@ -1,7 +1,8 @@
 // How each family parameter is edited on the page. Parameters are named as in a design spec
 // (README, "Shaper families"); a parameter not listed here gets a plain number field.
 // kind: 'number' | 'integer' | 'numbers' (comma-separated list) | 'percent' (fraction shown in %)
-// | 'select' (with `options`) | 'boolean' | 'pairs' (impulses, one "time, amplitude" per line). `optional`: a blank field leaves the parameter out of the spec
+// | 'select' (with `options`) | 'boolean' | 'pairs' (impulses, one "time, amplitude" per line)
+// | 'points' (one "x, y" per line, sent as [[x, y], …]). `optional`: a blank field leaves the parameter out of the spec
 // (the core's default applies). FAMILY_PARAMS overrides PARAMS for one family.
 export const PARAMS = {
   derivatives: { label: 'Zero derivatives n', kind: 'integer', min: 0, max: 30, default: 3 },
@@ -20,6 +21,7 @@ export const PARAMS = {
   amplitudeMax: { label: 'Amplitude max (blank = none)', kind: 'number', optional: true },
   incrementMin: { label: 'Increment min (blank = none)', kind: 'number', optional: true },
   incrementMax: { label: 'Increment max (blank = none)', kind: 'number', optional: true },
+  maxDuration: { label: 'Max duration (s; blank = none)', kind: 'number', optional: true },
 };
 
 export const FAMILY_PARAMS = {
@@ -29,6 +31,30 @@ export const FAMILY_PARAMS = {
       kind: 'pairs',
       default: [{ time: 0, amplitude: 0.5 }, { time: 0.25, amplitude: 0.5 }],
     },
+  },
+  si: {
+    vtol: { label: 'Tolerable vibration Vtol (%)', kind: 'percent', default: 0.05 },
+    insensitivity: {
+      label: 'Insensitivity I (band f(1 ± I/2) around each mode; blank to use the band below)',
+      kind: 'number', optional: true, default: 0.4,
+    },
+    bandHz: { label: 'Band [low, high] Hz (one mode; blank = none)', kind: 'numbers', optional: true },
+    dampingRange: { label: 'Damping range [ζ low, ζ high] (blank = the modes\' ζ)', kind: 'numbers', optional: true },
+    sampleFrequenciesHz: {
+      label: 'Sample only these frequencies, Hz (blank = guarantee the whole band)', kind: 'numbers', optional: true,
+    },
+    vtolProfile: {
+      label: 'Vtol profile: one "frequency Hz, Vtol (fraction)" per line (blank = constant Vtol)',
+      kind: 'points', optional: true,
+    },
+    amplitudeMin: { label: 'Amplitude min (blank = 0)', kind: 'number', optional: true },
+    amplitudeMax: { label: 'Amplitude max (blank = 1)', kind: 'number', optional: true },
+    maxImpulses: { label: 'Max impulses (blank = any)', kind: 'integer', optional: true },
+  },
+  direct: {
+    derivatives: { label: 'Zero derivatives at every mode (0 = ZV, 1 = ZVD …)', kind: 'integer', min: 0, max: 4, default: 1 },
+    amplitudeMin: { label: 'Amplitude min (blank = 0)', kind: 'number', optional: true },
+    amplitudeMax: { label: 'Amplitude max (blank = 1)', kind: 'number', optional: true },
   },
   sampled: {
     impulses: { label: 'Impulses n', kind: 'integer', min: 2, max: 256, default: 36 },
@@ -51,6 +77,10 @@ export function parseParam(info, text) {
   }
   if (info.kind === 'select') return t;
   if (info.kind === 'boolean') return t === 'true';
+  if (info.kind === 'points') {
+    return t.split(/\n+/).map((l) => l.trim()).filter(Boolean)
+      .map((line) => line.split(/[,;\s]+/).filter(Boolean).map(Number));
+  }
   if (info.kind === 'pairs') {
     return t.split(/\n+/).map((l) => l.trim()).filter(Boolean).map((line) => {
       const [time, amplitude] = line.split(/[,;\s]+/).map((x) => (x === undefined || x === '' ? NaN : Number(x)));
@@ -67,6 +97,7 @@ export function formatParam(info, value) {
   if (value === undefined || value === null) return '';
   if (info.kind === 'numbers') return Array.isArray(value) ? value.join(', ') : String(value);
   if (info.kind === 'pairs') return Array.isArray(value) ? value.map((p) => `${p?.time}, ${p?.amplitude}`).join('\n') : '';
+  if (info.kind === 'points') return Array.isArray(value) ? value.map((p) => (Array.isArray(p) ? p.join(', ') : String(p))).join('\n') : '';
   if (info.kind === 'boolean') return String(Boolean(value));
   if (info.kind === 'percent') return Number.isFinite(value) ? String(+(value * 100).toPrecision(10)) : '';
   return String(value);

@@ -49,6 +49,24 @@ export const PRESETS = [
     },
   },
   {
+    id: 'pelaez',
+    title: 'Peláez & Singhose 2002: 0.5 Hz, ζ = 0.002, SI with I = 0.7 at 5 % vs ZVD and EI',
+    state: {
+      modes: [{ frequencyHz: 0.5, damping: 0.002 }],
+      shapers: [{ family: 'si', vtol: 0.05, insensitivity: 0.7 }, { family: 'zvd' }, { family: 'ei', vtol: 0.05 }],
+      view: { vtol: 0.05, scv: 5 },
+    },
+  },
+  {
+    id: 'multimode',
+    title: 'Two modes, 1 Hz and 2.7 Hz: direct multi-mode ZVD vs convolved ZVD and SI',
+    state: {
+      modes: [{ frequencyHz: 1, damping: 0.02 }, { frequencyHz: 2.7, damping: 0.02 }],
+      shapers: [{ family: 'direct', derivatives: 1 }, { family: 'zvd' }, { family: 'si', vtol: 0.05, insensitivity: 0.3 }],
+      view: { vtol: 0.05, scv: 5 },
+    },
+  },
+  {
     id: 'printer',
     title: '3D-printer axis: 45 Hz, ζ = 0.1',
     state: {
