@@ -554,12 +554,28 @@ impl StreamingShaper {
         for (xin, yout) in input.chunks(CHUNK).zip(output.chunks_mut(CHUNK)) {
             let len = xin.len();
             scratch[m..m + len].copy_from_slice(xin);
-            yout.iter_mut().for_each(|y| *y = 0.0);
-            for (&d, &w) in self.delays.iter().zip(&self.weights) {
-                let src = &scratch[m - d..m - d + len];
-                for (y, x) in yout.iter_mut().zip(src) {
-                    *y += w * x;
+            // Register blocking: LANES outputs are accumulated over all taps before they are
+            // stored, so each tap costs one load per sample (not a load and a store of y too).
+            const LANES: usize = 8;
+            let blocked = len - len % LANES;
+            for (b, yb) in yout[..blocked].chunks_exact_mut(LANES).enumerate() {
+                let k = b * LANES;
+                let mut acc = [0.0; LANES];
+                for (&d, &w) in self.delays.iter().zip(&self.weights) {
+                    let src = &scratch[m - d + k..m - d + k + LANES];
+                    for (a, x) in acc.iter_mut().zip(src) {
+                        *a += w * x;
+                    }
                 }
+                yb.copy_from_slice(&acc);
+            }
+            for (k, y) in yout.iter_mut().enumerate().skip(blocked) {
+                *y = self
+                    .delays
+                    .iter()
+                    .zip(&self.weights)
+                    .map(|(&d, &w)| w * scratch[m - d + k])
+                    .sum();
             }
             scratch.copy_within(len..len + m, 0);
         }

@@ -117,9 +117,9 @@ impl Lti {
     /// The state jump a knot causes: a jump Jⱼ in the command's j-th derivative is a Dirac
     /// Jⱼδ in derivative j + 1, which E turns into the state jump E[:, j+1]·Jⱼ. A Dirac's
     /// derivative (E reading derivative ≥ j + 2 of a jump in j) is rejected.
-    fn impulse(&self, jumps: &[f64; ORDER], time: f64) -> Result<Vec<f64>> {
-        let n = self.states();
-        let mut imp = vec![0.0; n];
+    /// Written into `imp` (one entry per state), reused across knots.
+    fn impulse(&self, jumps: &[f64; ORDER], time: f64, imp: &mut [f64]) -> Result<()> {
+        imp.iter_mut().for_each(|v| *v = 0.0);
         for (j, &jump) in jumps.iter().enumerate() {
             if jump == 0.0 {
                 continue;
@@ -149,7 +149,7 @@ impl Lti {
                 }
             }
         }
-        Ok(imp)
+        Ok(())
     }
 
     /// Exact response to `command` at t = k·`sample_period`, k = 0 … `samples` − 1. The plant
@@ -171,6 +171,7 @@ impl Lti {
         let mut cache: HashMap<u64, Vec<BlockMaps>> = HashMap::new();
         let mut x = vec![0.0; n];
         let mut xn = vec![0.0; n];
+        let mut imp = vec![0.0; n];
         let mut outputs: [Vec<f64>; OUTPUTS] = Default::default();
         for o in outputs.iter_mut() {
             o.reserve_exact(samples);
@@ -199,6 +200,19 @@ impl Lti {
             // Advance x from t_prev to t.
             if k > 0 {
                 for (bm, &(start, m)) in maps.iter().zip(&self.blocks) {
+                    if m == 2 {
+                        // A mode (the common block): unrolled, no inner loops over m.
+                        let (x0, x1) = (x[start], x[start + 1]);
+                        let (p, g) = (&bm.phi, &bm.gamma);
+                        let (mut s0, mut s1) = (p[0] * x0 + p[1] * x1, p[2] * x0 + p[3] * x1);
+                        for (kk, wv) in w_prev[..q].iter().enumerate() {
+                            s0 += g[kk] * wv;
+                            s1 += g[q + kk] * wv;
+                        }
+                        xn[start] = s0;
+                        xn[start + 1] = s1;
+                        continue;
+                    }
                     let xb = &x[start..start + m];
                     for (i, xo) in xn[start..start + m].iter_mut().enumerate() {
                         let phi = &bm.phi[i * m..(i + 1) * m];
@@ -221,7 +235,7 @@ impl Lti {
                     break;
                 }
                 let delta = t - knot.time;
-                let imp = self.impulse(&knot.jumps, knot.time)?;
+                self.impulse(&knot.jumps, knot.time, &mut imp)?;
                 if delta == 0.0 {
                     for (xi, v) in x.iter_mut().zip(&imp) {
                         *xi += v;
