@@ -18,7 +18,7 @@
 //! - [`shaper`]: the impulse sequence, convolution, duration, centroid delay.
 //! - [`vibration`]: V(ω, ζ) (Singhose 2009 eq. 11), sensitivity curves over frequency and
 //!   damping, the frequency × damping map, insensitivity bands.
-//! - [`design`]: the spec, the table of families, and one file per family of the literature.
+//! - [`design`](mod@design): the spec, the table of families, and one file per family of the literature.
 //! - [`smoothing`]: Klipper-compatible smoothing and suggested maximum acceleration.
 //! - [`export`]: CSV, JSON, C arrays and RepRapFirmware `M593` lines.
 //! - [`command`]: reference commands (step, ramp, trapezoid, S-curve, sampled) and shaping
