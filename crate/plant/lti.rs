@@ -13,7 +13,7 @@
 //! Outputs are rows y = C x + D w: base position/velocity/acceleration and endpoint
 //! position/velocity/acceleration.
 
-use crate::command::{Cursor, Piecewise, ORDER};
+use crate::command::{Piecewise, ORDER};
 use crate::error::{Error, Result};
 use nalgebra::DMatrix;
 use std::collections::HashMap;
@@ -55,9 +55,6 @@ struct BlockMaps {
     phi: Vec<f64>,   // m × m, row-major
     gamma: Vec<f64>, // m × q, row-major
 }
-
-/// One output row as (state index, coefficient) and (command derivative, coefficient) pairs.
-type SparseRow = (Vec<(usize, f64)>, Vec<(usize, f64)>);
 
 /// Samples of the six outputs and the final state.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,19 +114,24 @@ impl Lti {
     /// The state jump a knot causes: a jump Jⱼ in the command's j-th derivative is a Dirac
     /// Jⱼδ in derivative j + 1, which E turns into the state jump E[:, j+1]·Jⱼ. A Dirac's
     /// derivative (E reading derivative ≥ j + 2 of a jump in j) is rejected.
-    /// Written into `imp` (one entry per state), reused across knots.
-    fn impulse(&self, jumps: &[f64; ORDER], time: f64, imp: &mut [f64]) -> Result<()> {
-        imp.iter_mut().for_each(|v| *v = 0.0);
-        for (j, &jump) in jumps.iter().enumerate() {
+    /// Written into `imp` (one entry per state), reused across knots; `columns` are E's non-zero
+    /// columns as (derivative, column), from [`Self::input_columns`]. Returns false (and leaves
+    /// `imp` untouched) when the jump is zero, the common case of a plant driven by u alone.
+    fn impulse(
+        columns: &[(usize, Vec<f64>)],
+        jumps: &[f64; ORDER],
+        time: f64,
+        imp: &mut [f64],
+    ) -> Result<bool> {
+        let mut any = false;
+        // A jump in derivative j matters only if E reads a higher derivative.
+        let reach = columns.last().map_or(0, |(k, _)| *k).min(ORDER);
+        for (j, &jump) in jumps[..reach].iter().enumerate() {
             if jump == 0.0 {
                 continue;
             }
-            for k in j + 1..ORDER {
-                let col = self.e.column(k);
-                if col.iter().all(|&v| v == 0.0) {
-                    continue;
-                }
-                if k > j + 1 {
+            for (k, col) in columns.iter().filter(|(k, _)| *k > j) {
+                if *k > j + 1 {
                     let what = ["position", "velocity", "acceleration", "jerk"]
                         .get(j)
                         .copied()
@@ -144,16 +146,37 @@ impl Lti {
                         ),
                     ));
                 }
-                for (s, v) in imp.iter_mut().zip(col.iter()) {
+                if !any {
+                    imp.iter_mut().for_each(|v| *v = 0.0);
+                    any = true;
+                }
+                for (s, v) in imp.iter_mut().zip(col) {
                     *s += v * jump;
                 }
             }
         }
-        Ok(())
+        Ok(any)
+    }
+
+    /// E's non-zero columns as (command derivative, column).
+    fn input_columns(&self) -> Vec<(usize, Vec<f64>)> {
+        (0..self.e.ncols().min(ORDER))
+            .filter_map(|k| {
+                let col: Vec<f64> = self.e.column(k).iter().copied().collect();
+                col.iter().any(|&v| v != 0.0).then_some((k, col))
+            })
+            .collect()
     }
 
     /// Exact response to `command` at t = k·`sample_period`, k = 0 … `samples` − 1. The plant
     /// starts at rest (x = 0) before the command's first knot.
+    ///
+    /// Three passes, each a tight loop: (1) the command's derivatives w at every sample and the
+    /// state jumps of the knots (a knot between two samples contributes e^{M(t − τ)}(impulse,
+    /// jumps) at the next sample); (2) each independent block of states marched over all samples,
+    /// x ← Φx + Γw (a mode's 2 × 2 block unrolled); (3) each output row as a sum of whole
+    /// columns (vectorised). The sums are formed in the same order as a sample-by-sample loop
+    /// would form them.
     pub fn respond(
         &self,
         command: &Piecewise,
@@ -168,79 +191,38 @@ impl Lti {
             .iter()
             .map(|&b| self.block_maps(b, q, sample_period))
             .collect::<Result<_>>()?;
-        let mut cache: HashMap<u64, Vec<BlockMaps>> = HashMap::new();
-        let mut x = vec![0.0; n];
-        let mut xn = vec![0.0; n];
-        let mut imp = vec![0.0; n];
-        let mut outputs: [Vec<f64>; OUTPUTS] = Default::default();
-        for o in outputs.iter_mut() {
-            o.reserve_exact(samples);
-        }
-        let mut states = keep_states.then(|| Vec::with_capacity(n * samples));
-        let mut cursor = Cursor::new(command);
+        let columns = self.input_columns();
         let knots = command.knots();
-        // Outputs as sparse rows: (state index, coefficient) and (derivative, coefficient).
-        let sparse: Vec<SparseRow> = (0..OUTPUTS)
-            .map(|row| {
-                (
-                    (0..n)
-                        .filter(|&j| self.c[(row, j)] != 0.0)
-                        .map(|j| (j, self.c[(row, j)]))
-                        .collect(),
-                    (0..q)
-                        .filter(|&kk| self.d[(row, kk)] != 0.0)
-                        .map(|kk| (kk, self.d[(row, kk)]))
-                        .collect(),
-                )
-            })
-            .collect();
-        let mut w_prev = [0.0; ORDER];
-        for k in 0..samples {
+
+        // Pass 1: w[k·q + kk] = the command's kk-th derivative at sample k; the knots' state
+        // jumps as events (sample index, n values), in sample order.
+        let mut w: Vec<f64> = vec![0.0; samples * q];
+        let mut event_at: Vec<usize> = Vec::new();
+        let mut event_jump: Vec<f64> = Vec::new();
+        let mut cache: HashMap<u64, Vec<BlockMaps>> = HashMap::new();
+        let mut imp = vec![0.0; n];
+        // The command's Taylor state (first q derivatives) just after the last knot passed.
+        let mut anchor = vec![0.0; q];
+        let mut shifted = vec![0.0; q];
+        let mut anchor_time = command.start_time();
+        let mut next = 0;
+        for (k, wk) in w.chunks_exact_mut(q).enumerate() {
             let t = k as f64 * sample_period;
-            // Advance x from t_prev to t.
-            if k > 0 {
-                for (bm, &(start, m)) in maps.iter().zip(&self.blocks) {
-                    if m == 2 {
-                        // A mode (the common block): unrolled, no inner loops over m.
-                        let (x0, x1) = (x[start], x[start + 1]);
-                        let (p, g) = (&bm.phi, &bm.gamma);
-                        let (mut s0, mut s1) = (p[0] * x0 + p[1] * x1, p[2] * x0 + p[3] * x1);
-                        for (kk, wv) in w_prev[..q].iter().enumerate() {
-                            s0 += g[kk] * wv;
-                            s1 += g[q + kk] * wv;
-                        }
-                        xn[start] = s0;
-                        xn[start + 1] = s1;
-                        continue;
-                    }
-                    let xb = &x[start..start + m];
-                    for (i, xo) in xn[start..start + m].iter_mut().enumerate() {
-                        let phi = &bm.phi[i * m..(i + 1) * m];
-                        let gam = &bm.gamma[i * q..(i + 1) * q];
-                        let mut s = 0.0;
-                        for (p, xv) in phi.iter().zip(xb) {
-                            s += p * xv;
-                        }
-                        for (g, wv) in gam.iter().zip(&w_prev[..q]) {
-                            s += g * wv;
-                        }
-                        *xo = s;
-                    }
-                }
-                std::mem::swap(&mut x, &mut xn);
-            }
-            // Knots in (t_prev, t].
-            while let Some(knot) = knots.get(cursor.next_index()) {
+            while let Some(knot) = knots.get(next) {
                 if knot.time > t {
                     break;
                 }
                 let delta = t - knot.time;
-                self.impulse(&knot.jumps, knot.time, &mut imp)?;
+                let jumped = Self::impulse(&columns, &knot.jumps, knot.time, &mut imp)?;
                 if delta == 0.0 {
-                    for (xi, v) in x.iter_mut().zip(&imp) {
-                        *xi += v;
+                    if jumped {
+                        event_at.push(k);
+                        event_jump.extend_from_slice(&imp);
                     }
                 } else {
+                    if !jumped {
+                        imp.iter_mut().for_each(|v| *v = 0.0);
+                    }
                     let key = delta.to_bits();
                     if !cache.contains_key(&key) {
                         if cache.len() > 4096 {
@@ -254,8 +236,11 @@ impl Lti {
                         cache.insert(key, m);
                     }
                     if let Some(dm) = cache.get(&key) {
-                        for (b, &(start, m)) in self.blocks.iter().enumerate() {
-                            let bm = &dm[b];
+                        event_at.push(k);
+                        let base = event_jump.len();
+                        event_jump.resize(base + n, 0.0);
+                        let jump = &mut event_jump[base..];
+                        for (bm, &(start, m)) in dm.iter().zip(&self.blocks) {
                             for i in 0..m {
                                 let mut s = 0.0;
                                 for j in 0..m {
@@ -264,29 +249,134 @@ impl Lti {
                                 for kk in 0..q {
                                     s += bm.gamma[i * q + kk] * knot.jumps[kk];
                                 }
-                                x[start + i] += s;
+                                jump[start + i] = s;
                             }
                         }
                     }
                 }
-                cursor.pass_next();
-            }
-            let w = cursor.state_at(t);
-            for (out, (cs, ds)) in outputs.iter_mut().zip(&sparse) {
-                let mut y = 0.0;
-                for &(j, c) in cs {
-                    y += c * x[j];
+                taylor_shift(&anchor, knot.time - anchor_time, &mut shifted);
+                for ((a, s), j) in anchor.iter_mut().zip(&shifted).zip(&knot.jumps) {
+                    *a = s + j;
                 }
-                for &(kk, d) in ds {
-                    y += d * w[kk];
-                }
-                out.push(y);
+                anchor_time = knot.time;
+                next += 1;
             }
-            if let Some(s) = states.as_mut() {
-                s.extend_from_slice(&x);
+            if next > 0 {
+                taylor_shift(&anchor, t - anchor_time, wk);
             }
-            w_prev = w;
         }
+
+        // Pass 2: each block over all samples; xs[j][k] = state j at sample k.
+        let mut xs: Vec<Vec<f64>> = vec![Vec::new(); n];
+        for (bm, &(start, m)) in maps.iter().zip(&self.blocks) {
+            let mut out: Vec<Vec<f64>> = vec![vec![0.0; samples]; m];
+            let mut events = event_at
+                .iter()
+                .zip(event_jump.chunks_exact(n))
+                .map(|(&k, jump)| (k, &jump[start..start + m]))
+                .peekable();
+            let mut w_prev = w.chunks_exact(q);
+            if let [o0, o1] = &mut out[..] {
+                // A mode (the common block): unrolled, no inner loops over m.
+                let [p00, p01, p10, p11] = [bm.phi[0], bm.phi[1], bm.phi[2], bm.phi[3]];
+                let (g0, g1) = bm.gamma.split_at(q);
+                let (mut x0, mut x1) = (0.0, 0.0);
+                for (k, (y0, y1)) in o0.iter_mut().zip(o1.iter_mut()).enumerate() {
+                    if k > 0 {
+                        let (mut s0, mut s1) = (p00 * x0 + p01 * x1, p10 * x0 + p11 * x1);
+                        if let Some(wp) = w_prev.next() {
+                            for ((a, b), v) in g0.iter().zip(g1).zip(wp) {
+                                s0 += a * v;
+                                s1 += b * v;
+                            }
+                        }
+                        (x0, x1) = (s0, s1);
+                    }
+                    while let Some((_, jump)) = events.next_if(|(at, _)| *at == k) {
+                        x0 += jump[0];
+                        x1 += jump[1];
+                    }
+                    (*y0, *y1) = (x0, x1);
+                }
+            } else {
+                let mut xb = vec![0.0; m];
+                let mut prev = vec![0.0; m];
+                for k in 0..samples {
+                    if k > 0 {
+                        prev.copy_from_slice(&xb);
+                        let wp = w_prev.next().unwrap_or(&[]);
+                        for (i, xo) in xb.iter_mut().enumerate() {
+                            let mut s = 0.0;
+                            for (p, xv) in bm.phi[i * m..(i + 1) * m].iter().zip(&prev) {
+                                s += p * xv;
+                            }
+                            for (g, wv) in bm.gamma[i * q..(i + 1) * q].iter().zip(wp) {
+                                s += g * wv;
+                            }
+                            *xo = s;
+                        }
+                    }
+                    while let Some((_, jump)) = events.next_if(|(at, _)| *at == k) {
+                        for (xi, v) in xb.iter_mut().zip(jump) {
+                            *xi += v;
+                        }
+                    }
+                    for (o, &v) in out.iter_mut().zip(&xb) {
+                        o[k] = v;
+                    }
+                }
+            }
+            for (i, o) in out.into_iter().enumerate() {
+                xs[start + i] = o;
+            }
+        }
+
+        // Pass 3: outputs y = C x + D w, row by row over whole columns.
+        let mut outputs: [Vec<f64>; OUTPUTS] = Default::default();
+        for (row, out) in outputs.iter_mut().enumerate() {
+            *out = vec![0.0; samples];
+            for (j, xj) in xs.iter().enumerate() {
+                let c = self.c[(row, j)];
+                if c != 0.0 {
+                    for (y, x) in out.iter_mut().zip(xj) {
+                        *y += c * x;
+                    }
+                }
+            }
+            for kk in 0..q {
+                let d = self.d[(row, kk)];
+                if d != 0.0 {
+                    for (y, wk) in out.iter_mut().zip(w.chunks_exact(q)) {
+                        *y += d * wk[kk];
+                    }
+                }
+            }
+        }
+        let states = keep_states.then(|| {
+            let mut s = Vec::with_capacity(n * samples);
+            for k in 0..samples {
+                s.extend(xs.iter().map(|xj| xj[k]));
+            }
+            s
+        });
         Ok(LtiResponse { outputs, states })
+    }
+}
+
+/// `out[k] = Σ_{m ≥ k} state[m] hᵐ⁻ᵏ/(m − k)!`: a polynomial's derivatives shifted by `h`
+/// (the same sums, in the same order, as `command::taylor_shift`, on the first
+/// `state.len()` derivatives only).
+#[inline]
+fn taylor_shift(state: &[f64], h: f64, out: &mut [f64]) {
+    for (k, o) in out.iter_mut().enumerate() {
+        let mut sum = 0.0;
+        let mut pw = 1.0; // h^{m-k}/(m-k)!
+        for (i, s) in state.iter().skip(k).enumerate() {
+            if i > 0 {
+                pw *= h / i as f64;
+            }
+            sum += s * pw;
+        }
+        *o = sum;
     }
 }
