@@ -478,19 +478,14 @@ fn shaped_command(spec: &ShaperSpec, shaper: &Shaper, command: &Command) -> Resu
     }
 }
 
-/// Metrics of a simulated move (with the per-mode residuals on a modal plant).
+/// Metrics of a simulated move. The per-mode residuals (`modeResidualPercent`) are left out:
+/// the page does not show them and they cost a second simulation per move.
 fn move_metrics(
-    plant: &Plant,
     traj: &Trajectory,
     applied: &Command,
     reference: &Command,
 ) -> Result<Metrics, Error> {
-    let mut m = crate::metrics::metrics(traj, applied, reference)?;
-    if let Plant::Modal(mp) = plant {
-        m.mode_residual_percent =
-            crate::metrics::mode_residual_percent(mp, &applied.to_piecewise()?)?;
-    }
-    Ok(m)
+    crate::metrics::metrics(traj, applied, reference)
 }
 
 thread_local! {
@@ -665,15 +660,15 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
             .map_err(|e| js_error(e.within("view")))
     };
     let unshaped = sim(&command)?;
-    let unshaped_metrics = move_metrics(&plant, &unshaped, &command, &command)
-        .map_err(|e| js_error(e.within("view")))?;
+    let unshaped_metrics =
+        move_metrics(&unshaped, &command, &command).map_err(|e| js_error(e.within("view")))?;
     let mut trajectories = Vec::with_capacity(commands.len());
     for (k, c) in commands.iter().enumerate() {
         let t = sim(c)?;
         let force = c != &command && shapers[k].centroid_delay().is_none();
         let reference = if force { c } else { &command };
         results[k].simulation =
-            Some(move_metrics(&plant, &t, c, reference).map_err(|e| js_error(e.within("view")))?);
+            Some(move_metrics(&t, c, reference).map_err(|e| js_error(e.within("view")))?);
         trajectories.push(t);
     }
     let robustness =
