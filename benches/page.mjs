@@ -20,7 +20,7 @@ const state = {
   shapers: [{ family: 'zv' }, { family: 'zvd' }, { family: 'zvdd' }, { family: 'zvdn', derivatives: 3 }],
   view: {
     vtol: 0.05, scv: 5, mismatch: 1.1, mapShaper: 1, plant: { kind: 'modal' },
-    command: { kind: 'trapezoid', distance: 1, maxVelocity: 0.8, maxAcceleration: 8 },
+    command: { kind: 'trapezoid', distance: 1, maxVelocity: 0.75, maxAcceleration: 8 },
   },
 };
 

@@ -26,7 +26,7 @@ const trapezoid = (distance, maxVelocity, maxAcceleration) => ({ kind: 'trapezoi
 export const DEFAULT_STATE = {
   modes: [{ frequencyHz: 2, damping: 0.05 }],
   shapers: [{ family: 'zvd' }],
-  view: view(trapezoid(1, 0.8, 8)),
+  view: view(trapezoid(1, 0.75, 8)),
 };
 
 /** Presets from the papers (and one printer axis). */

@@ -152,7 +152,8 @@ pub fn draw_robustness<DB: DrawingBackend>(
             .label(m.label.to_string())
             .legend(move |(x, y)| Circle::new((x + 8, y), ring.min(8), color.stroke_width(width)));
     }
-    draw_legend(&mut chart, SeriesLabelPosition::LowerRight, style)?;
+    // Upper left: short, very insensitive shapers do not exist, so no point hides there.
+    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, style)?;
     area.present().map_err(render_error)?;
     Ok(())
 }
