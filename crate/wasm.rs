@@ -283,7 +283,7 @@ impl Default for PlaygroundView {
             map_damping_points: 40,
             damping_to: None,
             damping_points: 200,
-            spectrum_points: 400,
+            spectrum_points: 300,
         }
     }
 }
@@ -732,7 +732,29 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
                 crate::spectrum::command_spectrum(c, &so).map_err(|e| js_error(e.within("view")))
             };
             let unshaped = one(&command)?;
-            let shaped = commands.iter().map(one).collect::<Result<Vec<_>, _>>()?;
+            // A piecewise command shaped by a shaper is their convolution, so its transform is
+            // the product: |U_s(f)| = |S(f)|·|U(f)| exactly, at O(impulses) per frequency
+            // instead of O(knots). Force-profile moves and sampled commands (shaped by the
+            // streaming filter) are transformed directly.
+            let shaped = specs
+                .iter()
+                .zip(&shapers)
+                .zip(&commands)
+                .map(|((spec, shaper), c)| {
+                    let own_move =
+                        matches!(spec, ShaperSpec::Bangbang { .. } | ShaperSpec::Onoff { .. });
+                    if own_move || !matches!(command, Command::Piecewise(_)) {
+                        return one(c).map(|s| s.magnitude);
+                    }
+                    let s = crate::spectrum::impulse_spectrum(shaper, &so)
+                        .map_err(|e| js_error(e.within("view")))?;
+                    Ok(s.magnitude
+                        .iter()
+                        .zip(&unshaped.magnitude)
+                        .map(|(a, b)| a * b)
+                        .collect())
+                })
+                .collect::<Result<Vec<Vec<f64>>, JsValue>>()?;
             Some((unshaped, shaped))
         }
         None => None,
@@ -816,7 +838,7 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
         let series: Vec<(&str, &[f64])> = shaped
             .iter()
             .enumerate()
-            .map(|(i, s)| (named(i), s.magnitude.as_slice()))
+            .map(|(i, s)| (named(i), s.as_slice()))
             .collect();
         chart::draw_spectrum(
             &b.into_drawing_area(),

@@ -337,3 +337,39 @@ fn robustness_chart_marks_the_chosen_shapers_on_the_families() {
         assert!(!anchors[i + 1..].contains(a), "two texts at {a:?}");
     }
 }
+
+/// The page draws a shaped command's spectrum as |S(f)|·|U(f)| (the shaped command is the
+/// convolution of the shaper with the command, so its transform is the product). Checked here
+/// against the direct transform of the shaped piecewise command, for a multi-mode shaper.
+#[test]
+fn shaped_spectrum_is_the_product_of_shaper_and_command_spectra() {
+    use input_shaping::design::design_for;
+    use input_shaping::design::ShaperSpec;
+    use input_shaping::spectrum::impulse_spectrum;
+    let modes = [
+        Mode::new(1.2, 0.012).unwrap(),
+        Mode::new(3.4, 0.013).unwrap(),
+    ];
+    let spec: ShaperSpec = serde_json::from_str(r#"{"family":"zvd"}"#).unwrap();
+    let shaper = design_for(&spec, &modes).unwrap();
+    let command =
+        Command::Piecewise(input_shaping::command::s_curve(0.5, 0.5, 2.0, 20.0, 0.0).unwrap());
+    let options = SpectrumOptions {
+        from_hz: 0.0,
+        to_hz: 8.0,
+        points: 301,
+        signal: SpectrumSignal::Velocity,
+    };
+    let u = command_spectrum(&command, &options).unwrap();
+    let s = impulse_spectrum(&shaper, &options).unwrap();
+    let direct = command_spectrum(&command.shaped(&shaper).unwrap(), &options).unwrap();
+    for j in 0..options.points {
+        let product = s.magnitude[j] * u.magnitude[j];
+        assert!(
+            (product - direct.magnitude[j]).abs() < 1e-9 * u.magnitude[0],
+            "f = {}: {product} vs {}",
+            u.frequency_hz[j],
+            direct.magnitude[j]
+        );
+    }
+}

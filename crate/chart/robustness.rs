@@ -104,6 +104,18 @@ pub fn draw_robustness<DB: DrawingBackend>(
             (x - r, y - r, x + r, y + r)
         })
         .collect();
+    // The rings of the compared shapers, drawn later, must not hide a name either.
+    taken.extend(
+        marks
+            .iter()
+            .filter(|m| m.duration_periods.is_finite() && m.insensitivity.is_finite())
+            .enumerate()
+            .map(|(k, m)| {
+                let (x, y) = to_px((m.duration_periods, m.insensitivity));
+                let ring = style.px(7.0 + 2.0 * k as f64) as i32 + 2;
+                (x - ring, y - ring, x + ring, y + ring)
+            }),
+    );
     let mut labels = Vec::new();
     for row in families.iter().filter(valid) {
         let (x, y) = to_px((row.duration_periods, row.insensitivity));
