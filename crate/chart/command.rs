@@ -77,8 +77,8 @@ pub fn draw_command<DB: DrawingBackend>(
             .label_style(("sans-serif", style.font(11.0)))
             .axis_desc_style(("sans-serif", style.font(12.0)))
             .light_line_style(RGBColor(238, 238, 238))
-            .x_labels(8)
-            .y_labels(4);
+            .x_labels(6)
+            .y_labels(3);
         if last {
             mesh.x_desc("time (s)");
         }

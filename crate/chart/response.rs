@@ -68,8 +68,8 @@ pub fn draw_response<DB: DrawingBackend>(
             .label_style(("sans-serif", style.font(12.0)))
             .axis_desc_style(("sans-serif", style.font(13.0)))
             .light_line_style(RGBColor(238, 238, 238))
-            .x_labels(8)
-            .y_labels(5);
+            .x_labels(6)
+            .y_labels(4);
         if !legend {
             mesh.x_desc("time (s)");
         }
