@@ -69,7 +69,7 @@ pub fn draw_response<DB: DrawingBackend>(
             .axis_desc_style(("sans-serif", style.font(13.0)))
             .light_line_style(RGBColor(238, 238, 238))
             .x_labels(6)
-            .y_labels(4);
+            .y_labels(6);
         if !legend {
             mesh.x_desc("time (s)");
         }
