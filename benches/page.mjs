@@ -1,6 +1,9 @@
 // Page benchmark (not a test): time full updates of the playground in headless Chromium —
-// recompute everything and redraw every chart, as one input event does — with 3 modes and
+// recompute everything and redraw every chart (impulses, V(f), V(ζ), the map, the simulated
+// response, the command, its spectrum, robustness), as one input event does — with 3 modes and
 // 4 compared shapers, and report p50 / p95 / max in ms, plus the shipped size (gzip).
+// Two kinds of edit: a mode's frequency (everything recomputed, including the robustness
+// table, designed for mode 1) and the mismatch r (the robustness table comes from the cache).
 // Run: npm run bench:page   (after npm run build)
 import { chromium } from 'playwright-core';
 import { readFileSync, readdirSync } from 'node:fs';
@@ -15,7 +18,10 @@ const state = {
     { frequencyHz: 7.9, damping: 0.02 },
   ],
   shapers: [{ family: 'zv' }, { family: 'zvd' }, { family: 'zvdd' }, { family: 'zvdn', derivatives: 3 }],
-  view: { vtol: 0.05, scv: 5 },
+  view: {
+    vtol: 0.05, scv: 5, mismatch: 1.1, mapShaper: 1, plant: { kind: 'modal' },
+    command: { kind: 'trapezoid', distance: 1, maxVelocity: 0.75, maxAcceleration: 8 },
+  },
 };
 
 const { server, url } = await startServer({ port: 0 });
@@ -27,22 +33,28 @@ try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
   await page.goto(`${url}#state=${encodeURIComponent(JSON.stringify(state))}`);
   await page.waitForSelector('body[data-ready="true"]');
-  const times = await page.evaluate(async (runs) => {
-    const out = [];
-    for (let i = 0; i < 10; i++) window.__playground.update(); // warm up
-    for (let i = 0; i < runs; i++) {
-      const input = document.getElementById('mode-0-frequency');
-      input.value = String(1.2 + (i % 10) * 0.01);
-      window.__playground.state.modes[0].frequencyHz = Number(input.value);
-      out.push(window.__playground.update());
+  const charts = await page.$$eval('.charts canvas', (c) => c.length);
+  for (const [shapers, edit] of [[4, 'mode'], [4, 'mismatch'], [1, 'mode'], [1, 'mismatch']]) {
+    if (shapers === 1) {
+      await page.evaluate(() => { const pg = window.__playground; pg.state.shapers.splice(1); pg.state.shapers[0] = { family: 'zvd' }; pg.state.view.mapShaper = 0; pg.update(); });
     }
-    return out;
-  }, RUNS);
-  const errors = await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
-  if (errors.length) throw new Error(`page errors during the benchmark: ${errors.join('; ')}`);
-  times.sort((a, b) => a - b);
-  const q = (p) => times[Math.min(times.length - 1, Math.floor(p * times.length))];
-  console.log(`full update, 3 modes, 4 shapers, all charts (${RUNS} runs): p50 ${q(0.5).toFixed(2)} ms, p95 ${q(0.95).toFixed(2)} ms, max ${times[times.length - 1].toFixed(2)} ms (budget: p95 16 ms)`);
+    const times = await page.evaluate(async ([runs, what]) => {
+      const out = [];
+      const pg = window.__playground;
+      for (let i = 0; i < 10; i++) pg.update(); // warm up
+      for (let i = 0; i < runs; i++) {
+        if (what === 'mode') pg.state.modes[0].frequencyHz = 1.2 + (i % 10) * 0.01;
+        else pg.state.view.mismatch = 0.8 + (i % 40) * 0.01;
+        out.push(pg.update());
+      }
+      return out;
+    }, [RUNS, edit]);
+    const errors = await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
+    if (errors.length) throw new Error(`page errors during the benchmark: ${errors.join('; ')}`);
+    times.sort((a, b) => a - b);
+    const q = (p) => times[Math.min(times.length - 1, Math.floor(p * times.length))];
+    console.log(`full update after a ${edit} edit, 3 modes, ${shapers === 4 ? '4 shapers (ZV, ZVD, ZVDD, ZV-D³: 8 … 125 impulses)' : '1 shaper (ZVD, 27 impulses)'}, ${charts} charts (${RUNS} runs): p50 ${q(0.5).toFixed(2)} ms, p95 ${q(0.95).toFixed(2)} ms, max ${times[times.length - 1].toFixed(2)} ms (budget: p95 16 ms)`);
+  }
 } finally {
   await browser.close();
   server.close();

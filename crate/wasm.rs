@@ -3,15 +3,22 @@
 //! `Error` whose message starts with the offending field and whose `field` property holds it.
 
 use crate::chart::{self, ChartStyle};
+use crate::command::{Command, CommandSpec, Knot, Piecewise, ORDER};
 use crate::design::{self, DesignRequest, ShaperSpec};
 use crate::error::Error;
+use crate::metrics::Metrics;
 use crate::mode::{Mode, ModeSpec};
+use crate::plant::{ModalPlant, Pendulum, PendulumSpec, Plant};
+use crate::robustness::RobustnessRow;
 use crate::shaper::{Shaper, ShaperData};
+use crate::simulate::Trajectory;
+use crate::spectrum::{SpectrumOptions, SpectrumSignal};
 use crate::vibration::{self, SensitivityOptions};
 use plotters::prelude::*;
 use plotters_canvas::CanvasBackend;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
+use std::cell::RefCell;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::HtmlCanvasElement;
@@ -230,6 +237,28 @@ struct PlaygroundView {
     scv: f64,
     /// Device pixel ratio the canvases were sized with.
     pixel_ratio: f64,
+    /// Model mismatch of the simulation: actual frequency = model × `mismatch`.
+    mismatch: f64,
+    /// The reference command of the simulation (as `simulate` takes it).
+    command: CommandSpec,
+    /// The simulated plant, built from the (mismatched) modes.
+    plant: ViewPlant,
+    /// Samples of each simulated response.
+    samples: usize,
+    /// Simulated seconds (default: the longest shaped move + 3 periods of the slowest mode).
+    duration: Option<f64>,
+    /// Which compared shaper the frequency × damping map shows (index into `shapers`).
+    map_shaper: usize,
+    /// Resolution of the map.
+    map_frequency_points: usize,
+    map_damping_points: usize,
+    /// Upper damping ratio of V(ζ) and the map (default max(0.2, 3 × the highest mode's ζ),
+    /// at most 0.9).
+    damping_to: Option<f64>,
+    /// Points of V(ζ).
+    damping_points: usize,
+    /// Frequencies of the command spectrum (over the V(f) range).
+    spectrum_points: usize,
 }
 
 impl Default for PlaygroundView {
@@ -241,8 +270,44 @@ impl Default for PlaygroundView {
             vtol: 0.05,
             scv: crate::smoothing::KLIPPER_SCV,
             pixel_ratio: 1.0,
+            mismatch: 1.0,
+            command: CommandSpec::Step {
+                distance: 1.0,
+                start: 0.0,
+            },
+            plant: ViewPlant::Modal,
+            samples: 1000,
+            duration: None,
+            map_shaper: 0,
+            map_frequency_points: 120,
+            map_damping_points: 40,
+            damping_to: None,
+            damping_points: 200,
+            spectrum_points: 300,
         }
     }
+}
+
+/// The playground's simulated plant: `modal` (the modes × mismatch, equal participation) or
+/// `pendulum` (a nonlinear crane pendulum whose linearised mode is the first mode × mismatch).
+#[derive(Deserialize, Default, Clone, Copy)]
+#[serde(tag = "kind", rename_all = "camelCase")]
+enum ViewPlant {
+    #[default]
+    Modal,
+    #[serde(rename_all = "camelCase")]
+    Pendulum {
+        /// Gravity, m/s² (default 9.81).
+        #[serde(default = "default_gravity")]
+        gravity: f64,
+        /// Swing angle at t = 0, rad (default 0).
+        #[serde(default)]
+        initial_angle: f64,
+    },
+}
+
+fn default_gravity() -> f64 {
+    9.81
 }
 
 /// Everything the page shows about one shaper.
@@ -259,6 +324,21 @@ struct ShaperResult {
     /// `None` (JS `null`) for shapers whose amplitudes sum to zero (bang-bang, on/off):
     /// Klipper's smoothing divides by that sum.
     klipper: Option<crate::smoothing::KlipperFigures>,
+    /// Metrics of the shaped move on the simulated (mismatched) plant.
+    simulation: Option<Metrics>,
+}
+
+/// The simulation of a frame, without its samples (those are drawn, not returned).
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct SimulationSummary {
+    mismatch: f64,
+    plant: &'static str,
+    plant_modes_hz: Vec<f64>,
+    duration: f64,
+    sample_period: f64,
+    samples: usize,
+    unshaped: Metrics,
 }
 
 #[derive(Serialize)]
@@ -272,6 +352,14 @@ struct PlaygroundResult {
     insensitivity: Vec<vibration::Insensitivity>,
     residual_at_modes: Vec<f64>,
     centroid_delay: Option<f64>,
+    /// The simulated move: plant, window and the unshaped command's metrics.
+    simulation: SimulationSummary,
+    /// Singhose 2009 Fig. 11 for mode 1: every parameterless family designed for it.
+    robustness: Vec<RobustnessRow>,
+    /// Index of the shaper the map shows.
+    map_shaper: usize,
+    /// Upper damping ratio of V(ζ) and the map.
+    damping_to: f64,
 }
 
 fn canvas(canvases: &JsValue, key: &str) -> Option<HtmlCanvasElement> {
@@ -297,17 +385,158 @@ fn labels(specs: &[ShaperSpec]) -> Vec<String> {
         .collect()
 }
 
+/// Checks that `value` lies in `[lo, hi]` (and is finite), naming `field`.
+fn within_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64, Error> {
+    if value.is_finite() && (lo..=hi).contains(&value) {
+        Ok(value)
+    } else {
+        Err(Error::invalid(
+            field,
+            format!("must be a number from {lo} to {hi}, got {value}"),
+        ))
+    }
+}
+
+/// Checks a count in `[lo, hi]`, naming `field`.
+fn count_in(field: &str, value: usize, lo: usize, hi: usize) -> Result<usize, Error> {
+    if (lo..=hi).contains(&value) {
+        Ok(value)
+    } else {
+        Err(Error::invalid(
+            field,
+            format!("must be a whole number from {lo} to {hi}, got {value}"),
+        ))
+    }
+}
+
+/// The simulated plant of a frame: the modes with frequencies × `mismatch`.
+fn view_plant(modes: &[Mode], view: &PlaygroundView) -> Result<Plant, Error> {
+    let r = within_range("view.mismatch", view.mismatch, 0.05, 20.0)?;
+    let at_mismatch = |e: Error| Error::invalid("view.mismatch", e.to_string());
+    match view.plant {
+        ViewPlant::Modal => {
+            let actual = modes
+                .iter()
+                .map(|m| Mode::new(m.frequency_hz() * r, m.damping()).map_err(at_mismatch))
+                .collect::<Result<Vec<_>, _>>()?;
+            let share = 1.0 / actual.len() as f64;
+            let participation = vec![share; actual.len()];
+            Ok(Plant::Modal(
+                ModalPlant::new(actual, participation).map_err(|e| e.within("view.plant"))?,
+            ))
+        }
+        ViewPlant::Pendulum {
+            gravity,
+            initial_angle,
+        } => {
+            let mode = &modes[0];
+            let omega = mode.omega_rad_s() * r;
+            let spec = PendulumSpec {
+                length: gravity / (omega * omega),
+                gravity,
+                damping: mode.damping(),
+                initial_angle,
+                hoist: None,
+            };
+            Ok(Plant::Pendulum(
+                Pendulum::from_spec(&spec).map_err(|e| e.within("view.plant"))?,
+            ))
+        }
+    }
+}
+
+/// The command a shaper sends: the reference shaped by it, or — for the force-profile families
+/// (bang-bang, on/off), whose amplitudes sum to 0 — their own rest-to-rest move, with
+/// acceleration `maxAcceleration` × (shaper ∗ unit step).
+fn shaped_command(spec: &ShaperSpec, shaper: &Shaper, command: &Command) -> Result<Command, Error> {
+    let force = match spec {
+        ShaperSpec::Bangbang {
+            max_acceleration, ..
+        }
+        | ShaperSpec::Onoff {
+            max_acceleration, ..
+        } => Some(*max_acceleration),
+        _ => None,
+    };
+    match force {
+        Some(a) => {
+            let knots = shaper
+                .impulses()
+                .iter()
+                .map(|imp| {
+                    let mut jumps = [0.0; ORDER];
+                    jumps[2] = a * imp.amplitude;
+                    Knot {
+                        time: imp.time,
+                        jumps,
+                    }
+                })
+                .collect();
+            Ok(Command::Piecewise(Piecewise::new(knots)?))
+        }
+        None => command.shaped(shaper).map_err(|e| e.within("view.command")),
+    }
+}
+
+/// Metrics of a simulated move. The per-mode residuals (`modeResidualPercent`) are left out:
+/// the page does not show them and they cost a second simulation per move.
+fn move_metrics(
+    traj: &Trajectory,
+    applied: &Command,
+    reference: &Command,
+) -> Result<Metrics, Error> {
+    crate::metrics::metrics(traj, applied, reference)
+}
+
+thread_local! {
+    /// The last robustness table and its key (mode 1's frequency and damping, Vtol, as bits):
+    /// designing every family is the slowest part of a frame and only these inputs change it.
+    static ROBUSTNESS: RefCell<Option<([u64; 3], Vec<RobustnessRow>)>> = const { RefCell::new(None) };
+}
+
+fn robustness_rows(mode: &Mode, vtol: f64) -> Result<Vec<RobustnessRow>, Error> {
+    let key = [
+        mode.frequency_hz().to_bits(),
+        mode.damping().to_bits(),
+        vtol.to_bits(),
+    ];
+    if let Some(rows) = ROBUSTNESS.with_borrow(|c| {
+        c.as_ref()
+            .filter(|(k, _)| *k == key)
+            .map(|(_, r)| r.clone())
+    }) {
+        return Ok(rows);
+    }
+    // Families that cannot be designed for this mode (e.g. EI beyond its damping range) are
+    // left out of the background rather than failing the frame.
+    let rows: Vec<RobustnessRow> = crate::robustness::parameterless_specs()
+        .into_iter()
+        .filter_map(|spec| {
+            crate::robustness::robustness_table(std::slice::from_ref(&spec), mode, vtol).ok()
+        })
+        .flatten()
+        .collect();
+    ROBUSTNESS.with_borrow_mut(|c| *c = Some((key, rows.clone())));
+    Ok(rows)
+}
+
 /// `renderPlayground(state, canvases)`: everything one frame of the page needs, in one call.
 ///
 /// `state = { modes, shapers: [{ family, …parameters }] (1 … 4; or `shaper` for one),
-/// view: { fromHz, toHz, points, vtol, scv, pixelRatio } }`; `canvases = { impulses?,
-/// sensitivity? }` (HTMLCanvasElements). Designs every shaper, computes its sensitivity curve
-/// (at the first mode's damping), insensitivity and residual vibration at each mode and
-/// Klipper's smoothing figures, draws the charts overlaid, and returns `{ results: [{ label,
-/// family, shaper, sensitivity, insensitivity, residualAtModes, centroidDelay, klipper:
-/// { smoothing, maxAccel } }], …the first result's fields }`. Errors name the field
-/// (`shapers[1].vtol`, `modes[0].damping`, `view.vtol`). Nothing is drawn unless everything
-/// computed, so a bad input leaves the last good charts on screen.
+/// view: { fromHz, toHz, points, vtol, scv, pixelRatio, mismatch, command, plant, samples,
+/// duration, mapShaper, mapFrequencyPoints, mapDampingPoints, dampingTo, dampingPoints,
+/// spectrumPoints } }` (README, "JavaScript API"); `canvases = { impulses?, sensitivity?,
+/// damping?, map?, response?, command?, spectrum?, robustness? }` (HTMLCanvasElements).
+/// Designs every shaper, computes its sensitivity curve (at the first mode's damping),
+/// insensitivity and residual vibration at each mode and Klipper's smoothing figures, simulates
+/// the unshaped and every shaped move on the plant with the mismatched modes, and draws the
+/// charts overlaid. Returns `{ results: [{ label, family, shaper, sensitivity, insensitivity,
+/// residualAtModes, centroidDelay, klipper: { smoothing, maxAccel }, simulation }],
+/// simulation: { mismatch, plant, plantModesHz, duration, samplePeriod, samples, unshaped },
+/// robustness, mapShaper, dampingTo, …the first result's fields }`. Errors name the field
+/// (`shapers[1].vtol`, `modes[0].damping`, `view.vtol`, `view.mismatch`,
+/// `view.command.maxVelocity`). Nothing is drawn unless everything computed, so a bad input
+/// leaves the last good charts on screen.
 #[wasm_bindgen(js_name = renderPlayground)]
 pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, JsValue> {
     let state: PlaygroundState = from_js(state, "").map_err(js_error)?;
@@ -369,9 +598,82 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
                 .collect(),
             centroid_delay: shaper.centroid_delay(),
             klipper,
+            simulation: None,
         });
         shapers.push(shaper);
     }
+
+    // The view's analysis settings.
+    let z_max = modes.iter().map(Mode::damping).fold(0.0_f64, f64::max);
+    let damping_to = match view.damping_to {
+        Some(z) => within_range("view.dampingTo", z, 1e-3, 0.99).map_err(js_error)?,
+        None => (3.0 * z_max).clamp(0.2, 0.9),
+    };
+    if view.map_shaper >= specs.len() {
+        return Err(js_error(Error::invalid(
+            "view.mapShaper",
+            format!(
+                "must be one of the compared shapers, 0 … {}, got {}",
+                specs.len() - 1,
+                view.map_shaper
+            ),
+        )));
+    }
+    count_in(
+        "view.mapFrequencyPoints",
+        view.map_frequency_points,
+        2,
+        1000,
+    )
+    .map_err(js_error)?;
+    count_in("view.mapDampingPoints", view.map_damping_points, 2, 500).map_err(js_error)?;
+    count_in("view.dampingPoints", view.damping_points, 2, 5000).map_err(js_error)?;
+    count_in("view.spectrumPoints", view.spectrum_points, 2, 5000).map_err(js_error)?;
+    let samples = count_in("view.samples", view.samples, 50, 20_000).map_err(js_error)?;
+
+    // The simulated move on the mismatched plant.
+    let plant = view_plant(&modes, view).map_err(js_error)?;
+    let command =
+        Command::from_spec(&view.command).map_err(|e| js_error(e.within("view.command")))?;
+    let commands = specs
+        .iter()
+        .zip(&shapers)
+        .map(|(spec, shaper)| shaped_command(spec, shaper, &command))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(js_error)?;
+    let plant_modes = plant.modes().map_err(js_error)?;
+    let slowest = plant_modes
+        .iter()
+        .map(Mode::damped_period_s)
+        .fold(0.0_f64, f64::max);
+    let end = commands
+        .iter()
+        .map(Command::end_time)
+        .fold(command.end_time(), f64::max);
+    let duration = match view.duration {
+        Some(d) => within_range("view.duration", d, 1e-6, 1e6).map_err(js_error)?,
+        None => (end + 3.0 * slowest).max(1e-3),
+    };
+    let sample_period = duration / (samples - 1) as f64;
+    let sim = |c: &Command| {
+        crate::simulate::simulate(&plant, c, sample_period, duration)
+            .map_err(|e| js_error(e.within("view")))
+    };
+    let unshaped = sim(&command)?;
+    let unshaped_metrics =
+        move_metrics(&unshaped, &command, &command).map_err(|e| js_error(e.within("view")))?;
+    let mut trajectories = Vec::with_capacity(commands.len());
+    for (k, c) in commands.iter().enumerate() {
+        let t = sim(c)?;
+        let force = c != &command && shapers[k].centroid_delay().is_none();
+        let reference = if force { c } else { &command };
+        results[k].simulation =
+            Some(move_metrics(&t, c, reference).map_err(|e| js_error(e.within("view")))?);
+        trajectories.push(t);
+    }
+    let robustness =
+        robustness_rows(&modes[0], view.vtol).map_err(|e| js_error(e.within("view")))?;
+
     let style = ChartStyle {
         scale: if view.pixel_ratio.is_finite() && view.pixel_ratio > 0.0 {
             view.pixel_ratio
@@ -379,28 +681,191 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
             1.0
         },
     };
-    if let Some(backend) = canvas(&canvases, "impulses").and_then(CanvasBackend::with_canvas_object)
-    {
-        let series: Vec<(&str, &Shaper)> = labels
-            .iter()
-            .map(String::as_str)
-            .zip(shapers.iter())
+    let backend = |key: &str| canvas(&canvases, key).and_then(CanvasBackend::with_canvas_object);
+    // Curves drawn only when their canvas is given, but computed before anything is drawn.
+    let damping_curves = match canvas(&canvases, "damping") {
+        Some(_) => Some(
+            shapers
+                .iter()
+                .map(|s| {
+                    vibration::damping_sensitivity(
+                        s,
+                        &vibration::DampingSensitivityOptions {
+                            frequency_hz: modes[0].frequency_hz(),
+                            from_damping: 0.0,
+                            to_damping: damping_to,
+                            points: view.damping_points,
+                        },
+                    )
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| js_error(e.within("view")))?,
+        ),
+        None => None,
+    };
+    let map = match canvas(&canvases, "map") {
+        Some(_) => Some(
+            vibration::sensitivity_map(
+                &shapers[view.map_shaper],
+                &vibration::SensitivityMapOptions {
+                    from_hz: options.from_hz,
+                    to_hz: options.to_hz,
+                    frequency_points: view.map_frequency_points,
+                    damping_from: 0.0,
+                    damping_to,
+                    damping_points: view.map_damping_points,
+                },
+            )
+            .map_err(|e| js_error(e.within("view")))?,
+        ),
+        None => None,
+    };
+    let spectra = match canvas(&canvases, "spectrum") {
+        Some(_) => {
+            let so = SpectrumOptions {
+                from_hz: options.from_hz,
+                to_hz: options.to_hz,
+                points: view.spectrum_points,
+                signal: SpectrumSignal::Velocity,
+            };
+            let one = |c: &Command| {
+                crate::spectrum::command_spectrum(c, &so).map_err(|e| js_error(e.within("view")))
+            };
+            let unshaped = one(&command)?;
+            // A piecewise command shaped by a shaper is their convolution, so its transform is
+            // the product: |U_s(f)| = |S(f)|·|U(f)| exactly, at O(impulses) per frequency
+            // instead of O(knots). Force-profile moves and sampled commands (shaped by the
+            // streaming filter) are transformed directly.
+            let shaped = specs
+                .iter()
+                .zip(&shapers)
+                .zip(&commands)
+                .map(|((spec, shaper), c)| {
+                    let own_move =
+                        matches!(spec, ShaperSpec::Bangbang { .. } | ShaperSpec::Onoff { .. });
+                    if own_move || !matches!(command, Command::Piecewise(_)) {
+                        return one(c).map(|s| s.magnitude);
+                    }
+                    let s = crate::spectrum::impulse_spectrum(shaper, &so)
+                        .map_err(|e| js_error(e.within("view")))?;
+                    Ok(s.magnitude
+                        .iter()
+                        .zip(&unshaped.magnitude)
+                        .map(|(a, b)| a * b)
+                        .collect())
+                })
+                .collect::<Result<Vec<Vec<f64>>, JsValue>>()?;
+            Some((unshaped, shaped))
+        }
+        None => None,
+    };
+
+    let modes_hz: Vec<f64> = modes.iter().map(Mode::frequency_hz).collect();
+    let actual_hz: Vec<f64> = plant_modes.iter().map(Mode::frequency_hz).collect();
+    let named = |i: usize| labels[i].as_str();
+    if let Some(b) = backend("impulses") {
+        let series: Vec<(&str, &Shaper)> = (0..shapers.len())
+            .map(|i| (named(i), &shapers[i]))
             .collect();
-        chart::draw_impulses(&backend.into_drawing_area(), &series, &style).map_err(js_error)?;
+        chart::draw_impulses(&b.into_drawing_area(), &series, &style).map_err(js_error)?;
     }
-    if let Some(backend) =
-        canvas(&canvases, "sensitivity").and_then(CanvasBackend::with_canvas_object)
-    {
-        let modes_hz: Vec<f64> = modes.iter().map(Mode::frequency_hz).collect();
+    if let Some(b) = backend("sensitivity") {
         let series: Vec<(&str, &vibration::SensitivityCurve)> = results
             .iter()
             .map(|r| (r.label.as_str(), &r.sensitivity))
             .collect();
         chart::draw_sensitivity(
-            &backend.into_drawing_area(),
+            &b.into_drawing_area(),
             &series,
             Some(view.vtol),
             &modes_hz,
+            &style,
+        )
+        .map_err(js_error)?;
+    }
+    if let (Some(b), Some(curves)) = (backend("damping"), &damping_curves) {
+        let series: Vec<(&str, &vibration::DampingSensitivityCurve)> = curves
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (named(i), c))
+            .collect();
+        let zetas: Vec<f64> = modes.iter().map(Mode::damping).collect();
+        chart::draw_damping_sensitivity(
+            &b.into_drawing_area(),
+            &series,
+            Some(view.vtol),
+            &zetas,
+            &style,
+        )
+        .map_err(js_error)?;
+    }
+    if let (Some(b), Some(map)) = (backend("map"), &map) {
+        let marks: Vec<(f64, f64)> = modes
+            .iter()
+            .map(|m| (m.frequency_hz(), m.damping()))
+            .collect();
+        chart::draw_sensitivity_map(&b.into_drawing_area(), map, Some(view.vtol), &marks, &style)
+            .map_err(js_error)?;
+    }
+    let traj_series: Vec<(&str, &Trajectory)> = trajectories
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (named(i), t))
+        .collect();
+    if let Some(b) = backend("response") {
+        let plant_name = match view.plant {
+            ViewPlant::Modal => "",
+            ViewPlant::Pendulum { .. } => ", nonlinear pendulum",
+        };
+        let caption = format!(
+            "Simulated response (actual f = model × {}{plant_name})",
+            (view.mismatch * 1e4).round() / 1e4
+        );
+        chart::draw_response(
+            &b.into_drawing_area(),
+            &unshaped,
+            &traj_series,
+            &caption,
+            &style,
+        )
+        .map_err(js_error)?;
+    }
+    if let Some(b) = backend("command") {
+        chart::draw_command(&b.into_drawing_area(), &unshaped, &traj_series, &style)
+            .map_err(js_error)?;
+    }
+    if let (Some(b), Some((u, shaped))) = (backend("spectrum"), &spectra) {
+        let series: Vec<(&str, &[f64])> = shaped
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (named(i), s.as_slice()))
+            .collect();
+        chart::draw_spectrum(
+            &b.into_drawing_area(),
+            &u.frequency_hz,
+            &u.magnitude,
+            &series,
+            &modes_hz,
+            &actual_hz,
+            &style,
+        )
+        .map_err(js_error)?;
+    }
+    if let Some(b) = backend("robustness") {
+        let period = modes[0].damped_period_s();
+        let marks: Vec<chart::RobustnessMark<'_>> = results
+            .iter()
+            .map(|r| chart::RobustnessMark {
+                label: r.label.as_str(),
+                duration_periods: r.shaper.duration / period,
+                insensitivity: r.insensitivity[0].width,
+            })
+            .collect();
+        chart::draw_robustness(
+            &b.into_drawing_area(),
+            &robustness,
+            &marks,
+            view.vtol,
             &style,
         )
         .map_err(js_error)?;
@@ -412,6 +877,21 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
         insensitivity: first.insensitivity.clone(),
         residual_at_modes: first.residual_at_modes.clone(),
         centroid_delay: first.centroid_delay,
+        simulation: SimulationSummary {
+            mismatch: view.mismatch,
+            plant: match view.plant {
+                ViewPlant::Modal => "modal",
+                ViewPlant::Pendulum { .. } => "pendulum",
+            },
+            plant_modes_hz: actual_hz,
+            duration,
+            sample_period,
+            samples,
+            unshaped: unshaped_metrics,
+        },
+        robustness,
+        map_shaper: view.map_shaper,
+        damping_to,
         results,
     };
     to_js(&result)

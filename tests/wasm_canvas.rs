@@ -131,3 +131,83 @@ fn zero_sum_shapers_render_with_null_klipper_figures() {
     assert!(klipper(2).is_object(), "ZV has them");
     assert!(series_pixels(&pixels(&imp)) > 50, "impulses drawn");
 }
+
+/// Every playground canvas gets ink in one call; the mismatch redraws the response but not the
+/// impulses; bang-bang's own move ends at rest at its distance (its simulated residual ≈ 0), and
+/// a bad mismatch leaves every canvas as it was.
+#[wasm_bindgen_test]
+fn render_playground_draws_every_chart_and_the_mismatch_moves_the_response() {
+    let keys = [
+        "impulses",
+        "sensitivity",
+        "damping",
+        "map",
+        "response",
+        "command",
+        "spectrum",
+        "robustness",
+    ];
+    let canvases = js_sys::Object::new();
+    let all: Vec<HtmlCanvasElement> = keys
+        .iter()
+        .map(|k| {
+            let c = canvas(560, 340);
+            Reflect::set(&canvases, &(*k).into(), &c).unwrap();
+            c
+        })
+        .collect();
+    let state = |r: &str| {
+        JSON::parse(&format!(
+            r#"{{"modes":[{{"frequencyHz":2,"damping":0.05}}],
+                "shapers":[{{"family":"zvd"}},{{"family":"bangbang","distance":1,"maxAcceleration":10}}],
+                "view":{{"mismatch":{r},"command":{{"kind":"trapezoid","distance":1,"maxVelocity":0.8,"maxAcceleration":8}}}}}}"#
+        ))
+        .unwrap()
+    };
+    let result = wasm::render_playground(state("1"), canvases.clone().into()).unwrap();
+    let first: Vec<Vec<u8>> = all.iter().map(pixels).collect();
+    for (k, p) in keys.iter().zip(&first) {
+        let ink = p
+            .chunks(4)
+            .filter(|q| q[0] < 230 || q[1] < 230 || q[2] < 230)
+            .count();
+        assert!(ink > 2000, "{k}: {ink} px of ink");
+    }
+    let results: js_sys::Array = Reflect::get(&result, &"results".into())
+        .unwrap()
+        .dyn_into()
+        .unwrap();
+    let residual = |k: u32| {
+        let sim = Reflect::get(&results.get(k), &"simulation".into()).unwrap();
+        Reflect::get(&sim, &"residualVibrationPercent".into())
+            .unwrap()
+            .as_f64()
+            .unwrap()
+    };
+    assert!(residual(0) < 1e-9, "ZVD at the exact mode: {}", residual(0));
+    assert!(residual(1) < 1e-9, "bang-bang's own move: {}", residual(1));
+
+    wasm::render_playground(state("1.2"), canvases.clone().into()).unwrap();
+    assert_eq!(
+        pixels(&all[0]),
+        first[0],
+        "impulses unchanged by the mismatch"
+    );
+    assert_ne!(pixels(&all[4]), first[4], "response redrawn for r = 1.2");
+    let second: Vec<Vec<u8>> = all.iter().map(pixels).collect();
+
+    let err: js_sys::Error = wasm::render_playground(state("-1"), canvases.into())
+        .unwrap_err()
+        .dyn_into()
+        .unwrap();
+    assert_eq!(
+        Reflect::get(&err, &"field".into())
+            .unwrap()
+            .as_string()
+            .as_deref(),
+        Some("view.mismatch")
+    );
+    for ((k, c), before) in keys.iter().zip(&all).zip(&second) {
+        assert_eq!(&pixels(c), before, "{k} kept after the error");
+    }
+}

@@ -4,6 +4,7 @@
 // inputs' data-field) while the last good charts and numbers stay.
 import init, { renderPlayground, families, exportShaper } from '../pkg/input_shaping.js';
 import { DEFAULT_STATE, PRESETS, MAX_MODES, MAX_SHAPERS, checkState, clone, toHash, fromHash } from './state.js';
+import { COMMAND_PARAMS, commandFor } from './params.js';
 import { paramInfo, parseParam, formatParam } from './params.js';
 
 const $ = (id) => document.getElementById(id);
@@ -135,6 +136,27 @@ function shaperCard(spec, k) {
     el('span', { class: 'error group-error', role: 'alert' }));
 }
 
+/** The command's parameter fields, for its kind. */
+function commandFields() {
+  const command = state.view.command;
+  return (COMMAND_PARAMS[command.kind] ?? []).map(([name, label]) => {
+    const input = el('input', {
+      id: `command-${name}`, type: 'number', step: 'any', inputmode: 'decimal',
+      value: String(command[name] ?? ''), dataset: { field: `view.command.${name}` },
+    });
+    input.addEventListener('input', () => { state.view.command[name] = readNumber(input); changed(); });
+    return field(label, input);
+  });
+}
+
+function mapShaperOptions() {
+  const sel = $('map-shaper');
+  sel.replaceChildren(...state.shapers.map((s, k) => el('option', { value: String(k) },
+    `Shaper ${k + 1}: ${familyTable.find((f) => f.name === s.family)?.title ?? s.family}`)));
+  if (!(state.view.mapShaper < state.shapers.length)) state.view.mapShaper = 0;
+  sel.value = String(state.view.mapShaper ?? 0);
+}
+
 function rebuild() {
   $('modes').replaceChildren(...state.modes.map(modeRow));
   $('shapers').replaceChildren(...state.shapers.map(shaperCard));
@@ -142,6 +164,12 @@ function rebuild() {
   $('add-shaper').disabled = state.shapers.length >= MAX_SHAPERS;
   $('vtol').value = formatParam({ kind: 'percent' }, state.view.vtol);
   $('scv').value = String(state.view.scv ?? '');
+  $('mismatch').value = String(state.view.mismatch ?? '');
+  if (Number.isFinite(state.view.mismatch)) $('mismatch-slider').value = String(state.view.mismatch);
+  $('plant-kind').value = state.view.plant?.kind ?? 'modal';
+  $('command-kind').value = state.view.command?.kind ?? 'step';
+  $('command-params').replaceChildren(...commandFields());
+  mapShaperOptions();
 }
 
 // ---------- errors ----------
@@ -199,6 +227,8 @@ function showResults(result, st) {
   $('summary').tBodies[0].replaceChildren(...rows.map(([name, f]) => el('tr', {},
     el('th', { scope: 'row' }, name), ...results.map((r) => el('td', {}, f(r))))));
 
+  showSimulation(result);
+
   $('impulse-tables').replaceChildren(...results.map((r, k) => el('table', { class: 'impulses', id: `impulses-${k}` },
     el('caption', {}, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), r.label),
     el('thead', {}, el('tr', {}, el('th', { scope: 'col' }, '#'), el('th', { scope: 'col' }, 'time (s)'), el('th', { scope: 'col' }, 'amplitude'))),
@@ -210,6 +240,30 @@ function showResults(result, st) {
   sel.replaceChildren(...results.map((r, k) => el('option', { value: String(k) }, r.label)));
   sel.value = keep && Number(keep) < results.length ? keep : '0';
   showExport();
+}
+
+/** The simulated move's metrics: the unshaped command and every shaper. */
+function showSimulation(result) {
+  const sim = result.simulation;
+  const columns = [{ label: 'Unshaped', color: '#6e6e6e', m: sim.unshaped },
+    ...result.results.map((r, k) => ({ label: r.label, color: COLORS[k], m: r.simulation }))];
+  $('simulation-summary').tHead.replaceChildren(el('tr', {}, el('th', { scope: 'col' }, ''),
+    ...columns.map((c) => el('th', { scope: 'col' }, el('span', { class: 'swatch', style: `background:${c.color}` }), c.label))));
+  const pct = (x) => (x == null ? '—' : Math.abs(x) < 1e-9 ? '≈ 0' : fmt(x, 4));
+  const num = (x, d = 5) => (x == null ? '—' : fmt(x, d));
+  const rows = [
+    ['Residual vibration after the move (% of distance)', (m) => pct(m.residualVibrationPercent)],
+    ['Settling time, 2 % band (s)', (m) => num(m.settlingTime2)],
+    ['Settling time, 5 % band (s)', (m) => num(m.settlingTime5)],
+    ['Move ends (s)', (m) => num(m.moveEnd)],
+    ['Peak deflection during the move', (m) => num(m.peakDeflection, 4)],
+    ['Peak command acceleration', (m) => (m.peakAcceleration == null ? '∞ (velocity jumps)' : fmt(m.peakAcceleration, 5))],
+    ['Acceleration peaks + valleys', (m) => String(m.accelerationPeakValleyCount)],
+  ];
+  $('simulation-summary').tBodies[0].replaceChildren(...rows.map(([name, f]) => el('tr', {},
+    el('th', { scope: 'row' }, name), ...columns.map((c) => el('td', {}, c.m ? f(c.m) : '—')))));
+  const plant = sim.plant === 'pendulum' ? 'nonlinear pendulum' : 'modal plant';
+  $('simulation-note').textContent = `(${plant}, actual modes ${sim.plantModesHz.map((f) => fmt(f, 4)).join(', ')} Hz = model × ${fmt(sim.mismatch, 4)}; ${sim.samples} samples over ${fmt(sim.duration, 4)} s)`;
 }
 
 function showExport() {
@@ -250,7 +304,10 @@ function sizeCanvas(canvas) {
 function update() {
   const t0 = performance.now();
   clearErrors();
-  const canvases = { impulses: $('impulses-chart'), sensitivity: $('sensitivity-chart') };
+  const canvases = {
+    impulses: $('impulses-chart'), sensitivity: $('sensitivity-chart'), damping: $('damping-chart'), map: $('map-chart'),
+    response: $('response-chart'), command: $('command-chart'), spectrum: $('spectrum-chart'), robustness: $('robustness-chart'),
+  };
   Object.values(canvases).forEach(sizeCanvas);
   const st = { ...state, view: { ...state.view, pixelRatio: window.devicePixelRatio || 1 } };
   try {
@@ -325,6 +382,26 @@ async function main() {
   });
   $('vtol').addEventListener('input', () => { state.view.vtol = parseParam({ kind: 'percent' }, $('vtol').value); changed(); });
   $('scv').addEventListener('input', () => { state.view.scv = readNumber($('scv')); changed(); });
+  $('mismatch').addEventListener('input', () => {
+    state.view.mismatch = readNumber($('mismatch'));
+    if (Number.isFinite(state.view.mismatch)) $('mismatch-slider').value = String(state.view.mismatch);
+    changed();
+  });
+  $('mismatch-slider').addEventListener('input', () => {
+    $('mismatch').value = $('mismatch-slider').value;
+    state.view.mismatch = Number($('mismatch-slider').value);
+    changed();
+  });
+  $('plant-kind').addEventListener('change', () => {
+    state.view.plant = $('plant-kind').value === 'pendulum' ? { kind: 'pendulum', gravity: 9.81, initialAngle: 0 } : { kind: 'modal' };
+    changed(true);
+  });
+  $('command-kind').addEventListener('change', () => {
+    state.view.command = commandFor($('command-kind').value, state.view.command);
+    $('command-params').replaceChildren(...commandFields());
+    changed(true);
+  });
+  $('map-shaper').addEventListener('change', () => { state.view.mapShaper = Number($('map-shaper').value); changed(true); });
   $('controls').addEventListener('change', () => { editing = false; });
   $('controls').addEventListener('submit', (e) => e.preventDefault());
   $('export-shaper').addEventListener('change', showExport);

@@ -102,3 +102,25 @@ export function formatParam(info, value) {
   if (info.kind === 'percent') return Number.isFinite(value) ? String(+(value * 100).toPrecision(10)) : '';
   return String(value);
 }
+
+/** The fields of each command kind of the simulation: [name, label]. */
+export const COMMAND_PARAMS = {
+  step: [['distance', 'Distance']],
+  trapezoid: [['distance', 'Distance'], ['maxVelocity', 'Max velocity (distance/s)'], ['maxAcceleration', 'Max acceleration (distance/s²)']],
+  sCurve: [['distance', 'Distance'], ['maxVelocity', 'Max velocity (distance/s)'], ['maxAcceleration', 'Max acceleration (distance/s²)'],
+    ['maxJerk', 'Max jerk (distance/s³)']],
+};
+
+/** A command of `kind` keeping what it shares with `previous` (limits default to a 1-unit move). */
+export function commandFor(kind, previous = {}) {
+  const distance = Number.isFinite(previous.distance) ? previous.distance : 1;
+  const next = { kind, distance };
+  if (kind === 'trapezoid' || kind === 'sCurve') {
+    next.maxVelocity = Number.isFinite(previous.maxVelocity) ? previous.maxVelocity : Math.abs(distance) || 1;
+    next.maxAcceleration = Number.isFinite(previous.maxAcceleration) ? previous.maxAcceleration : 10 * next.maxVelocity;
+  }
+  if (kind === 'sCurve') {
+    next.maxJerk = Number.isFinite(previous.maxJerk) ? previous.maxJerk : 20 * next.maxAcceleration;
+  }
+  return next;
+}

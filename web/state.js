@@ -3,16 +3,30 @@
 // state = {
 //   modes:   [{ frequencyHz, damping }]          1 … 6
 //   shapers: [{ family, …parameters }]            1 … 4
-//   view:    { vtol, scv }
+//   view:    { vtol, scv,                        analysis
+//              mismatch,                         simulation: actual frequency = model × mismatch
+//              command: { kind: 'step' | 'trapezoid' | 'sCurve', distance, maxVelocity?,
+//                         maxAcceleration?, maxJerk? },
+//              plant: { kind: 'modal' } | { kind: 'pendulum', gravity?, initialAngle? },
+//              mapShaper }                       which shaper the frequency × damping map shows
 // }
 
 export const MAX_MODES = 6;
 export const MAX_SHAPERS = 4;
 
+export const COMMAND_KINDS = ['step', 'trapezoid', 'sCurve'];
+export const PLANT_KINDS = ['modal', 'pendulum'];
+
+/** A view with the simulation defaults and the given command. */
+const view = (command, extra = {}) => ({
+  vtol: 0.05, scv: 5, mismatch: 1, command, plant: { kind: 'modal' }, mapShaper: 0, ...extra,
+});
+const trapezoid = (distance, maxVelocity, maxAcceleration) => ({ kind: 'trapezoid', distance, maxVelocity, maxAcceleration });
+
 export const DEFAULT_STATE = {
   modes: [{ frequencyHz: 2, damping: 0.05 }],
   shapers: [{ family: 'zvd' }],
-  view: { vtol: 0.05, scv: 5 },
+  view: view(trapezoid(1, 0.75, 8)),
 };
 
 /** Presets from the papers (and one printer axis). */
@@ -23,7 +37,7 @@ export const PRESETS = [
     state: {
       modes: [{ frequencyHz: 1, damping: 0.05 }],
       shapers: [{ family: 'zv' }, { family: 'zvd' }, { family: 'zvdd' }],
-      view: { vtol: 0.05, scv: 5 },
+      view: view({ kind: 'step', distance: 1 }),
     },
   },
   {
@@ -32,7 +46,7 @@ export const PRESETS = [
     state: {
       modes: [{ frequencyHz: 1.2, damping: 0.012 }, { frequencyHz: 3.4, damping: 0.013 }],
       shapers: [{ family: 'zv' }, { family: 'zvd' }],
-      view: { vtol: 0.05, scv: 5 },
+      view: view({ kind: 'sCurve', distance: 0.5, maxVelocity: 0.5, maxAcceleration: 2, maxJerk: 20 }),
     },
   },
   {
@@ -45,7 +59,7 @@ export const PRESETS = [
         { family: 'sampled', periodS: 0.012, impulses: 36, delaySamples: 17, weight: 0.1, derivatives: 1, plantGain: 8e-4, objective: 'minimumNorm' },
         { family: 'zvd' },
       ],
-      view: { vtol: 0.05, scv: 5 },
+      view: view(trapezoid(1, 1, 5)),
     },
   },
   {
@@ -54,7 +68,7 @@ export const PRESETS = [
     state: {
       modes: [{ frequencyHz: 0.5, damping: 0.002 }],
       shapers: [{ family: 'si', vtol: 0.05, insensitivity: 0.7 }, { family: 'zvd' }, { family: 'ei', vtol: 0.05 }],
-      view: { vtol: 0.05, scv: 5 },
+      view: view(trapezoid(1, 0.5, 0.5), { mismatch: 1.2 }),
     },
   },
   {
@@ -63,7 +77,17 @@ export const PRESETS = [
     state: {
       modes: [{ frequencyHz: 1, damping: 0.02 }, { frequencyHz: 2.7, damping: 0.02 }],
       shapers: [{ family: 'direct', derivatives: 1 }, { family: 'zvd' }, { family: 'si', vtol: 0.05, insensitivity: 0.3 }],
-      view: { vtol: 0.05, scv: 5 },
+      view: view(trapezoid(1, 1, 8)),
+    },
+  },
+  {
+    id: 'crane',
+    title: 'Overhead crane: 6.2 m cable (0.2 Hz), nonlinear pendulum, 4 m move',
+    state: {
+      // ω = √(g/ℓ): 0.2 Hz is a 6.21 m cable; the simulation swings the nonlinear pendulum.
+      modes: [{ frequencyHz: 0.2, damping: 0 }],
+      shapers: [{ family: 'zv' }, { family: 'zvd' }, { family: 'ei', vtol: 0.05 }],
+      view: view(trapezoid(4, 1, 2), { plant: { kind: 'pendulum', gravity: 9.81, initialAngle: 0 } }),
     },
   },
   {
@@ -71,8 +95,9 @@ export const PRESETS = [
     title: '3D-printer axis: 45 Hz, ζ = 0.1',
     state: {
       modes: [{ frequencyHz: 45, damping: 0.1 }],
-      shapers: [{ family: 'zv' }, { family: 'zvd' }],
-      view: { vtol: 0.05, scv: 5 },
+      shapers: [{ family: 'zv' }, { family: 'zvd' }, { family: 'mzv' }, { family: 'ei', vtol: 0.05 }],
+      // A 10 mm move at 200 mm/s and 5000 mm/s² (units: mm).
+      view: view(trapezoid(10, 200, 5000)),
     },
   },
 ];
@@ -115,9 +140,33 @@ export function checkState(value) {
   if (view !== undefined && (typeof view !== 'object' || view === null || Array.isArray(view))) {
     fail('"view" must be an object');
   }
+  checkView(view ?? {}, fail);
   const out = clone({ modes, shapers, view: { ...DEFAULT_STATE.view, ...(view ?? {}) } });
   out.modes = out.modes.map((m) => ({ frequencyHz: m.frequencyHz, damping: m.damping ?? 0 }));
   return out;
+}
+
+/** Known view settings: their types. Unknown keys may hold only short plain values. */
+function checkView(view, fail) {
+  const num = (x) => typeof x === 'number' || x === null;
+  const plain = (o) => o && typeof o === 'object' && !Array.isArray(o);
+  for (const [k, v] of Object.entries(view)) {
+    if (['vtol', 'scv', 'mismatch', 'mapShaper', 'fromHz', 'toHz', 'points', 'samples', 'duration', 'dampingTo'].includes(k)) {
+      if (!num(v)) fail(`view.${k} must be a number`);
+    } else if (k === 'command') {
+      if (!plain(v) || !COMMAND_KINDS.includes(v.kind)) fail(`view.command must be { kind: ${COMMAND_KINDS.join(' | ')}, … }`);
+      for (const [ck, cv] of Object.entries(v)) {
+        if (ck !== 'kind' && !num(cv)) fail(`view.command.${ck} must be a number`);
+      }
+    } else if (k === 'plant') {
+      if (!plain(v) || !PLANT_KINDS.includes(v.kind)) fail(`view.plant must be { kind: ${PLANT_KINDS.join(' | ')} }`);
+      for (const [pk, pv] of Object.entries(v)) {
+        if (pk !== 'kind' && !num(pv)) fail(`view.plant.${pk} must be a number`);
+      }
+    } else if (!(num(v) || typeof v === 'boolean' || (typeof v === 'string' && v.length <= 200))) {
+      fail(`view.${k} has an unsupported value`);
+    }
+  }
 }
 
 /** The URL hash for a state: `#state=` + URI-encoded JSON (readable, and shareable as is). */

@@ -1,18 +1,26 @@
 //! Charts, each written once against plotters' [`DrawingBackend`]: the page draws them on a
 //! canvas (plotters-canvas), native tests into an SVG string they can assert on.
 
+pub mod command;
 pub mod damping;
 pub mod impulses;
 pub mod map;
+pub mod response;
+pub mod robustness;
 pub mod sensitivity;
+pub mod spectrum;
 
 use crate::error::Error;
 use plotters::prelude::*;
 
+pub use command::draw_command;
 pub use damping::draw_damping_sensitivity;
 pub use impulses::draw_impulses;
 pub use map::draw_sensitivity_map;
+pub use response::draw_response;
+pub use robustness::{draw_robustness, RobustnessMark};
 pub use sensitivity::draw_sensitivity;
+pub use spectrum::draw_spectrum;
 
 /// Colours of up to four overlaid series (colour-blind-safe Okabe–Ito hues).
 pub const SERIES_COLORS: [RGBColor; 4] = [
@@ -57,5 +65,132 @@ impl ChartStyle {
 pub(crate) fn render_error<E: std::fmt::Debug>(e: E) -> Error {
     Error::Render {
         reason: format!("{e:?}"),
+    }
+}
+
+/// Colour of the unshaped reference in the simulation, command and spectrum charts.
+pub const UNSHAPED_COLOR: RGBColor = RGBColor(110, 110, 110);
+
+/// The smallest and largest finite values of `values` (with a little padding, and a unit range
+/// around a constant), for an axis.
+pub(crate) fn padded_range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (-1.0, 1.0);
+    }
+    let span = hi - lo;
+    if span <= 1e-12 * lo.abs().max(hi.abs()).max(1e-300) {
+        let half = (0.5 * lo.abs()).max(1e-9);
+        return (lo - half, hi + half);
+    }
+    (lo - pad * span, hi + pad * span)
+}
+
+/// At most about `2 × buckets` points of the polyline (x, y) that keep each bucket's smallest
+/// and largest y in order (a min–max decimation: the drawn envelope is the same as with every
+/// point, but a canvas draws far fewer segments). Non-finite points are dropped.
+pub(crate) fn decimate(x: &[f64], y: &[f64], buckets: usize) -> Vec<(f64, f64)> {
+    let n = x.len().min(y.len());
+    let points = (0..n).filter(|&i| x[i].is_finite() && y[i].is_finite());
+    if n <= 2 * buckets.max(1) {
+        return points.map(|i| (x[i], y[i])).collect();
+    }
+    let per = n.div_ceil(buckets.max(1));
+    let mut out = Vec::with_capacity(2 * buckets + 2);
+    let mut start = 0;
+    while start < n {
+        let end = (start + per).min(n);
+        let (mut lo, mut hi) = (None::<usize>, None::<usize>);
+        for i in start..end {
+            if !(x[i].is_finite() && y[i].is_finite()) {
+                continue;
+            }
+            if lo.is_none_or(|l| y[i] < y[l]) {
+                lo = Some(i);
+            }
+            if hi.is_none_or(|h| y[i] > y[h]) {
+                hi = Some(i);
+            }
+        }
+        match (lo, hi) {
+            (Some(a), Some(b)) if a != b => {
+                let (a, b) = (a.min(b), a.max(b));
+                out.push((x[a], y[a]));
+                out.push((x[b], y[b]));
+            }
+            (Some(a), _) => out.push((x[a], y[a])),
+            _ => {}
+        }
+        start = end;
+    }
+    out
+}
+
+/// Draws the series legend of a chart in the page's style.
+pub(crate) fn draw_legend<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    style: &ChartStyle,
+) -> crate::error::Result<()>
+where
+    DB: DrawingBackend + 'a,
+    CT: plotters::coord::CoordTranslate,
+{
+    chart
+        .configure_series_labels()
+        .label_font(("sans-serif", style.font(12.0)))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(180, 180, 180))
+        .margin(style.px(6.0))
+        .legend_area_size(style.px(22.0))
+        .position(position)
+        .draw()
+        .map_err(render_error)
+}
+
+/// A legend swatch: a short thick line of `color`, scaled.
+pub(crate) fn swatch(
+    color: RGBColor,
+    style: &ChartStyle,
+) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    let (len, width) = (style.px(16.0) as i32, style.px(3.0));
+    move |(x, y)| PathElement::new(vec![(x, y), (x + len, y)], color.stroke_width(width))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn decimation_keeps_each_buckets_extremes() {
+        let x: Vec<f64> = (0..10_000).map(|i| i as f64).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .map(|t| (t * 0.37).sin() * (1.0 + t / 1e4))
+            .collect();
+        let d = decimate(&x, &y, 100);
+        assert!(d.len() <= 202, "{}", d.len());
+        let max = y.iter().copied().fold(f64::MIN, f64::max);
+        let min = y.iter().copied().fold(f64::MAX, f64::min);
+        assert!(d.iter().any(|p| p.1 == max) && d.iter().any(|p| p.1 == min));
+        assert!(d.windows(2).all(|w| w[0].0 < w[1].0), "in order");
+        // Short series pass through untouched (non-finite points dropped).
+        assert_eq!(
+            decimate(&[0.0, 1.0, 2.0], &[1.0, f64::NAN, 3.0], 100),
+            vec![(0.0, 1.0), (2.0, 3.0)]
+        );
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn padded_range_handles_constants_and_nothing() {
+        assert_eq!(padded_range([1.0, 3.0].into_iter(), 0.5), (0.0, 4.0));
+        let (lo, hi) = padded_range([2.0, 2.0].into_iter(), 0.1);
+        assert!(lo < 2.0 && hi > 2.0);
+        assert_eq!(padded_range([f64::NAN].into_iter(), 0.1), (-1.0, 1.0));
     }
 }

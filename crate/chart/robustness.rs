@@ -1,0 +1,171 @@
+//! The robustness chart: insensitivity I(Vtol) against shaper duration, one grey point per
+//! family designed for the mode (Singhose 2009 Fig. 11), and the compared shapers marked in
+//! their series colours.
+//!
+//! Family names are placed beside their points, moved above, below or to the left when they
+//! would overlap a name already placed (a greedy search in pixel space).
+
+use super::{draw_legend, render_error, ChartStyle};
+use crate::error::Result;
+use crate::robustness::RobustnessRow;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// A compared shaper's point on the robustness chart.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RobustnessMark<'a> {
+    /// Legend label.
+    pub label: &'a str,
+    /// Duration in damped periods of the mode.
+    pub duration_periods: f64,
+    /// Insensitivity I(Vtol) at the mode (fraction of its frequency).
+    pub insensitivity: f64,
+}
+
+/// A placed label's box in pixels: (left, top, right, bottom).
+type Box2 = (i32, i32, i32, i32);
+
+fn overlaps(a: Box2, b: Box2) -> bool {
+    a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3
+}
+
+/// Draws the `families` table (grey points, named) and the `marks` (rings in the series
+/// colours, with a legend), for tolerable vibration `vtol` (fraction, shown in the caption).
+pub fn draw_robustness<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    families: &[RobustnessRow],
+    marks: &[RobustnessMark<'_>],
+    vtol: f64,
+    style: &ChartStyle,
+) -> Result<()> {
+    area.fill(&WHITE).map_err(render_error)?;
+    let points = || {
+        families
+            .iter()
+            .map(|r| (r.duration_periods, r.insensitivity))
+            .chain(marks.iter().map(|m| (m.duration_periods, m.insensitivity)))
+            .filter(|(d, i)| d.is_finite() && i.is_finite())
+    };
+    let d_max = points().map(|p| p.0).fold(0.0_f64, f64::max);
+    let i_max = points().map(|p| p.1).fold(0.0_f64, f64::max);
+    let d_max = if d_max > 0.0 { d_max * 1.12 } else { 1.0 };
+    let i_max = if i_max > 0.0 { i_max * 1.15 } else { 1.0 };
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!(
+                "Robustness vs duration (I at Vtol {} %)",
+                (vtol * 100.0 * 1000.0).round() / 1000.0
+            ),
+            ("sans-serif", style.font(16.0)),
+        )
+        .margin(style.px(10.0))
+        .margin_right(style.px(16.0))
+        .x_label_area_size(style.px(40.0))
+        .y_label_area_size(style.px(60.0))
+        .build_cartesian_2d(0.0..d_max, 0.0..i_max)
+        .map_err(render_error)?;
+    chart
+        .configure_mesh()
+        .x_desc("duration (damped periods of mode 1)")
+        .y_desc("insensitivity I(Vtol)")
+        .label_style(("sans-serif", style.font(12.0)))
+        .axis_desc_style(("sans-serif", style.font(13.0)))
+        .light_line_style(RGBColor(238, 238, 238))
+        .draw()
+        .map_err(render_error)?;
+    let grey = RGBColor(120, 120, 120);
+    let dot = style.px(3.5);
+    let valid = |r: &&RobustnessRow| r.duration_periods.is_finite() && r.insensitivity.is_finite();
+    chart
+        .draw_series(
+            families
+                .iter()
+                .filter(valid)
+                .map(|r| Circle::new((r.duration_periods, r.insensitivity), dot, grey.filled())),
+        )
+        .map_err(render_error)?
+        .label("families (for mode 1)")
+        .legend(move |(x, y)| Circle::new((x + 8, y), dot, grey.filled()));
+    // Names, avoiding each other, the plot's edges and the points.
+    let font_px = style.font(11.0);
+    let font = ("sans-serif", font_px)
+        .into_font()
+        .color(&RGBColor(70, 70, 70));
+    let (x_range, y_range) = (chart.x_range(), chart.y_range());
+    let to_px = |p: (f64, f64)| chart.backend_coord(&p);
+    let (left, top) = to_px((x_range.start, y_range.end));
+    let (right, bottom) = to_px((x_range.end, y_range.start));
+    let r = dot as i32 + 1;
+    let mut taken: Vec<Box2> = families
+        .iter()
+        .filter(valid)
+        .map(|row| {
+            let (x, y) = to_px((row.duration_periods, row.insensitivity));
+            (x - r, y - r, x + r, y + r)
+        })
+        .collect();
+    // The rings of the compared shapers, drawn later, must not hide a name either.
+    taken.extend(
+        marks
+            .iter()
+            .filter(|m| m.duration_periods.is_finite() && m.insensitivity.is_finite())
+            .enumerate()
+            .map(|(k, m)| {
+                let (x, y) = to_px((m.duration_periods, m.insensitivity));
+                let ring = style.px(7.0 + 2.0 * k as f64) as i32 + 2;
+                (x - ring, y - ring, x + ring, y + ring)
+            }),
+    );
+    let mut labels = Vec::new();
+    for row in families.iter().filter(valid) {
+        let (x, y) = to_px((row.duration_periods, row.insensitivity));
+        let w = (0.56 * font_px * row.title.chars().count() as f64).ceil() as i32;
+        let h = font_px.ceil() as i32;
+        let gap = r + 2;
+        let candidates = [
+            (x + gap, y - h / 2),
+            (x - w / 2, y - gap - h),
+            (x - w / 2, y + gap),
+            (x - gap - w, y - h / 2),
+            (x + gap, y - h - gap / 2),
+            (x + gap, y + gap / 2),
+        ];
+        let fits = |&(lx, ly): &(i32, i32)| {
+            let b = (lx, ly, lx + w, ly + h);
+            b.0 >= left
+                && b.2 <= right
+                && b.1 >= top
+                && b.3 <= bottom
+                && !taken.iter().any(|t| overlaps(*t, b))
+        };
+        if let Some(&(lx, ly)) = candidates.iter().find(|c| fits(c)) {
+            taken.push((lx, ly, lx + w, ly + h));
+            labels.push((row.title.clone(), (lx, ly)));
+        }
+    }
+    for (text, pos) in labels {
+        area.draw(&Text::new(text, pos, font.clone()))
+            .map_err(render_error)?;
+    }
+    for (k, m) in marks.iter().enumerate() {
+        if !(m.duration_periods.is_finite() && m.insensitivity.is_finite()) {
+            continue;
+        }
+        let color = style.color(k);
+        let ring = style.px(7.0 + 2.0 * k as f64);
+        let width = style.px(2.5);
+        chart
+            .draw_series(std::iter::once(Circle::new(
+                (m.duration_periods, m.insensitivity),
+                ring,
+                color.stroke_width(width),
+            )))
+            .map_err(render_error)?
+            .label(m.label.to_string())
+            .legend(move |(x, y)| Circle::new((x + 8, y), ring.min(8), color.stroke_width(width)));
+    }
+    // Upper left: short, very insensitive shapers do not exist, so no point hides there.
+    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, style)?;
+    area.present().map_err(render_error)?;
+    Ok(())
+}

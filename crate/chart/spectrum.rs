@@ -1,0 +1,118 @@
+//! The command spectrum chart: |U(f)| of the unshaped command (grey) and of each shaped command
+//! (series colours), with the model's modes marked by solid lines and the actual (mismatched)
+//! modes by dashed ones — a shaped command should have (almost) no content at the modes
+//! (Veciana & Cardona 2011 §2).
+
+use super::{draw_legend, render_error, swatch, ChartStyle, UNSHAPED_COLOR};
+use crate::error::{Error, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Draws `unshaped` and each labelled `shaped` magnitude against `frequency_hz` (all the same
+/// length), a solid marker at each of `modes_hz` (the model) and a dashed one at each of
+/// `actual_hz` (the plant, when it differs). The magnitudes are those of the command's
+/// velocity (the page's choice: compactly supported for rest-to-rest moves, and a shaped
+/// step's is the shaper's own spectrum). Non-finite magnitudes are skipped.
+pub fn draw_spectrum<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    frequency_hz: &[f64],
+    unshaped: &[f64],
+    shaped: &[(&str, &[f64])],
+    modes_hz: &[f64],
+    actual_hz: &[f64],
+    style: &ChartStyle,
+) -> Result<()> {
+    let n = frequency_hz.len();
+    if n < 2 || unshaped.len() != n || shaped.iter().any(|(_, m)| m.len() != n) {
+        return Err(Error::invalid(
+            "spectrum",
+            "needs at least 2 frequencies and one magnitude per frequency in every series",
+        ));
+    }
+    area.fill(&WHITE).map_err(render_error)?;
+    let (f_lo, f_hi) = (frequency_hz[0], frequency_hz[n - 1]);
+    let (f_lo, f_hi) = if f_lo < f_hi {
+        (f_lo, f_hi)
+    } else {
+        (0.0, 1.0)
+    };
+    let top = std::iter::once(unshaped)
+        .chain(shaped.iter().map(|(_, m)| *m))
+        .flat_map(|m| m.iter().copied())
+        .filter(|v| v.is_finite())
+        .fold(0.0_f64, f64::max);
+    let top = if top > 0.0 { top * 1.08 } else { 1.0 };
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            "Command spectrum |U(f)| (velocity)",
+            ("sans-serif", style.font(16.0)),
+        )
+        .margin(style.px(10.0))
+        .margin_right(style.px(14.0))
+        .x_label_area_size(style.px(40.0))
+        .y_label_area_size(style.px(60.0))
+        .build_cartesian_2d(f_lo..f_hi, 0.0..top)
+        .map_err(render_error)?;
+    chart
+        .configure_mesh()
+        .x_desc("frequency (Hz)")
+        .y_desc("|U(f)|")
+        .label_style(("sans-serif", style.font(12.0)))
+        .axis_desc_style(("sans-serif", style.font(13.0)))
+        .light_line_style(RGBColor(238, 238, 238))
+        .draw()
+        .map_err(render_error)?;
+    let marker = RGBColor(90, 90, 90);
+    let inside = |f: &&f64| (f_lo..=f_hi).contains(*f);
+    let mut first = true;
+    for &f in modes_hz.iter().filter(inside) {
+        let s = chart
+            .draw_series(LineSeries::new(
+                [(f, 0.0), (f, top)],
+                marker.stroke_width(style.px(1.0)),
+            ))
+            .map_err(render_error)?;
+        if std::mem::take(&mut first) {
+            s.label("model modes").legend(swatch(marker, style));
+        }
+    }
+    let actual = RGBColor(200, 30, 30);
+    let differs = |a: f64| !modes_hz.iter().any(|m| (m - a).abs() <= 1e-9 * m.abs());
+    let mut first = true;
+    for &f in actual_hz.iter().filter(inside).filter(|a| differs(**a)) {
+        let s = chart
+            .draw_series(DashedLineSeries::new(
+                [(f, 0.0), (f, top)],
+                style.px(6.0),
+                style.px(4.0),
+                actual.stroke_width(style.px(1.5)),
+            ))
+            .map_err(render_error)?;
+        if std::mem::take(&mut first) {
+            s.label("actual modes").legend(swatch(actual, style));
+        }
+    }
+    let all = std::iter::once(("unshaped", unshaped, UNSHAPED_COLOR)).chain(
+        shaped
+            .iter()
+            .enumerate()
+            .map(|(k, (l, m))| (*l, *m, style.color(k))),
+    );
+    for (label, magnitude, color) in all {
+        chart
+            .draw_series(LineSeries::new(
+                frequency_hz
+                    .iter()
+                    .zip(magnitude)
+                    .filter(|(_, v)| v.is_finite())
+                    .map(|(&f, &v)| (f, v)),
+                color.stroke_width(style.px(if label == "unshaped" { 1.5 } else { 2.0 })),
+            ))
+            .map_err(render_error)?
+            .label(label.to_string())
+            .legend(swatch(color, style));
+    }
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, style)?;
+    area.present().map_err(render_error)?;
+    Ok(())
+}
