@@ -51,6 +51,8 @@ pub mod spectrum;
 pub mod vibration;
 
 #[cfg(target_arch = "wasm32")]
+mod canvas;
+#[cfg(target_arch = "wasm32")]
 pub mod wasm;
 
 pub use design::{design, DesignRequest, ShaperSpec};

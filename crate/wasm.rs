@@ -2,6 +2,7 @@
 //! plain JSON-like values (camelCase) through serde-wasm-bindgen; every error is thrown as a JS
 //! `Error` whose message starts with the offending field and whose `field` property holds it.
 
+use crate::canvas::Canvas;
 use crate::chart::{self, ChartStyle};
 use crate::command::{Command, CommandSpec, Knot, Piecewise, ORDER};
 use crate::design::{self, DesignRequest, ShaperSpec};
@@ -15,7 +16,6 @@ use crate::simulate::Trajectory;
 use crate::spectrum::{SpectrumOptions, SpectrumSignal};
 use crate::vibration::{self, SensitivityOptions};
 use plotters::prelude::*;
-use plotters_canvas::CanvasBackend;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::cell::RefCell;
@@ -681,7 +681,7 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
             1.0
         },
     };
-    let backend = |key: &str| canvas(&canvases, key).and_then(CanvasBackend::with_canvas_object);
+    let backend = |key: &str| canvas(&canvases, key).and_then(Canvas::new);
     // Curves drawn only when their canvas is given, but computed before anything is drawn.
     let damping_curves = match canvas(&canvases, "damping") {
         Some(_) => Some(
