@@ -38,6 +38,7 @@ pub mod command;
 pub mod design;
 pub mod error;
 pub mod export;
+pub mod measure;
 pub mod metrics;
 pub mod mode;
 pub mod plant;
