@@ -5,6 +5,7 @@ pub mod damping;
 pub mod impulses;
 pub mod map;
 pub mod sensitivity;
+pub mod spectrum;
 
 use crate::error::Error;
 use plotters::prelude::*;
@@ -13,6 +14,7 @@ pub use damping::draw_damping_sensitivity;
 pub use impulses::draw_impulses;
 pub use map::draw_sensitivity_map;
 pub use sensitivity::draw_sensitivity;
+pub use spectrum::draw_spectrum;
 
 /// Colours of up to four overlaid series (colour-blind-safe Okabe–Ito hues).
 pub const SERIES_COLORS: [RGBColor; 4] = [
