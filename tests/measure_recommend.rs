@@ -184,6 +184,14 @@ fn bad_recommendation_inputs_name_the_field() {
         field(recommend(&s, &[measured(50.0, 1.5)], &RecommendOptions::default()).unwrap_err()),
         "modes[0].damping"
     );
+    // A family that cannot be designed for the modes is skipped, not fatal.
+    let r = recommend(&s, &[measured(50.0, 0.6)], &RecommendOptions::default()).unwrap();
+    assert!(
+        r.skipped.iter().any(|k| k.label.starts_with("Two-hump EI")),
+        "{:?}",
+        r.skipped
+    );
+    assert!(!r.ranked.is_empty());
     let o = RecommendOptions {
         max_remaining_vibration: 0.0,
         ..RecommendOptions::default()

@@ -27,7 +27,9 @@
 //! over 5–200 Hz on the spectrum alone, every candidate is designed at the identified modes
 //! (all of them, and — with several modes — the dominant one alone, the one whose PSD peak
 //! is highest), and Klipper's low-frequency normalisation of its sweep data
-//! (`normalize_to_frequencies`) is not applied: the band starts at `minFrequencyHz`.
+//! (`normalize_to_frequencies`) is not applied: the band is `minFrequencyHz` …
+//! `maxFrequencyHz` (default half the lowest mode … three times the highest). Spectra of more
+//! than [`MAX_SCORED_BINS`] bins in the band are averaged over groups of neighbouring bins.
 //! The computation is deterministic: the same inputs give the same table.
 
 use crate::design::{design_for, ShaperSpec};
@@ -43,6 +45,8 @@ use std::f64::consts::PI;
 pub const SHAPER_VIBRATION_REDUCTION: f64 = 20.0;
 /// Most spectrum bins accepted.
 pub const MAX_BINS: usize = 1 << 21;
+/// Most bins scored: longer spectra are averaged over groups of neighbouring bins.
+pub const MAX_SCORED_BINS: usize = 1024;
 /// Most candidate families.
 pub const MAX_FAMILIES: usize = 16;
 
@@ -102,7 +106,7 @@ pub struct RecommendOptions {
     pub uncertainty_sigmas: f64,
     /// Lower end of the scored band (default half the lowest mode's frequency), Hz.
     pub min_frequency_hz: Option<f64>,
-    /// Upper end (default the spectrum's last bin), Hz.
+    /// Upper end (default 3 × the highest mode's frequency, or the spectrum's last bin), Hz.
     pub max_frequency_hz: Option<f64>,
 }
 
@@ -163,6 +167,16 @@ pub struct Candidate {
     pub acceptable: bool,
 }
 
+/// A candidate left out, and why.
+#[derive(Debug, Clone, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Skipped {
+    /// Its label.
+    pub label: String,
+    /// The design error.
+    pub reason: String,
+}
+
 /// The recommendation and the ranked table.
 #[derive(Debug, Clone, Serialize)]
 #[serde(rename_all = "camelCase")]
@@ -173,6 +187,8 @@ pub struct Recommendation {
     pub recommended: usize,
     /// The candidates, best first.
     pub ranked: Vec<Candidate>,
+    /// Candidates that could not be designed for the modes (e.g. a 2-hump EI at ζ = 0.6).
+    pub skipped: Vec<Skipped>,
     /// Damping ratios R was maximised over.
     pub damping_tested: Vec<f64>,
     /// Frequency factors V was evaluated at (f·factor).
@@ -207,8 +223,9 @@ pub fn remaining_vibration(
 
 /// Scores the candidate families over the measured spectrum (see the module docs).
 ///
-/// Errors: an empty or mismatched spectrum, a non-finite or negative bin, no modes or a bad
-/// mode (`modes[i].damping`), a candidate that cannot be designed (`families[i]…`), bad
+/// Candidates that cannot be designed for the modes are listed in `skipped`. Errors: an empty
+/// or mismatched spectrum, a non-finite or negative bin, no modes or a bad mode
+/// (`modes[i].damping`), no candidate that can be designed (`infeasible`), bad
 /// options (`maxRemainingVibration` outside (0, 1], `uncertaintySigmas` outside [0, 10]).
 pub fn recommend(
     spectrum: &MeasuredSpectrum,
@@ -272,9 +289,10 @@ pub fn recommend(
         Some(f) => finite("minFrequencyHz", f)?,
         None => 0.5 * lowest,
     };
+    let highest = valid.iter().map(Mode::frequency_hz).fold(0.0, f64::max);
     let f_hi = match options.max_frequency_hz {
         Some(f) => finite("maxFrequencyHz", f)?,
-        None => last,
+        None => last.min(3.0 * highest),
     };
     let (freq, psd): (Vec<f64>, Vec<f64>) = spectrum
         .frequency_hz
@@ -289,6 +307,20 @@ pub fn recommend(
             format!("the band [{f_lo}, {f_hi}] Hz holds no spectrum bin"),
         ));
     }
+    // Long spectra are averaged over groups of neighbouring bins (PSD level kept), so the
+    // score costs the same for a 0.05 Hz and a 1.5 Hz resolution (Klipper's 0.5 s windows).
+    let group = freq.len().div_ceil(MAX_SCORED_BINS);
+    let (freq, psd): (Vec<f64>, Vec<f64>) = if group > 1 {
+        freq.chunks(group)
+            .zip(psd.chunks(group))
+            .map(|(f, p)| {
+                let n = f.len() as f64;
+                (f.iter().sum::<f64>() / n, p.iter().sum::<f64>() / n)
+            })
+            .unzip()
+    } else {
+        (freq, psd)
+    };
     // Damping ratios and frequency factors covering the uncertainty.
     let mut damping_tested: Vec<f64> = Vec::new();
     for m in modes {
@@ -330,6 +362,7 @@ pub fn recommend(
         None
     };
     let mut candidates = Vec::new();
+    let mut skipped = Vec::new();
     for (i, spec) in families.iter().enumerate() {
         let title = spec.info().map_or(spec.name(), |f| f.title);
         let mut sets: Vec<(String, Vec<Mode>)> = vec![(title.to_string(), valid.clone())];
@@ -340,8 +373,16 @@ pub fn recommend(
             ));
         }
         for (label, design_modes) in sets {
-            let shaper =
-                design_for(spec, &design_modes).map_err(|e| e.within(&format!("families[{i}]")))?;
+            let shaper = match design_for(spec, &design_modes) {
+                Ok(s) => s,
+                Err(e) => {
+                    skipped.push(Skipped {
+                        label,
+                        reason: e.within(&format!("families[{i}]")).to_string(),
+                    });
+                    continue;
+                }
+            };
             let nominal = modes
                 .iter()
                 .map(|m| remaining_vibration(&shaper, &freq, &psd, m.damping, 1.0))
@@ -385,6 +426,18 @@ pub fn recommend(
                 acceptable: worst <= vmax,
             });
         }
+    }
+    if candidates.is_empty() {
+        return Err(Error::Infeasible {
+            reason: format!(
+                "no candidate could be designed for the modes: {}",
+                skipped
+                    .iter()
+                    .map(|s| s.reason.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        });
     }
     let recommended_label;
     match options.criterion {
@@ -442,6 +495,7 @@ pub fn recommend(
         criterion: options.criterion,
         recommended,
         ranked: candidates,
+        skipped,
         damping_tested,
         frequency_factors,
         band_hz: [f_lo, f_hi],

@@ -13,18 +13,21 @@ after(async () => { await env?.close(); });
 
 const MODES = [{ f: 38, z: 0.03, a: 1500 }, { f: 91, z: 0.06, a: 900 }];
 
-/** Klipper's raw format: a hit at 0.5 s rings down both modes; noise and a gravity offset. */
+/** Klipper's raw format: hits ring down both modes; noise and a gravity offset. */
 function klipperFile(rows, fs = 3200) {
   let seed = 12345;
-  const noise = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648 - 0.5; };
+  const noise = () => { seed ^= seed << 13; seed >>>= 0; seed ^= seed >>> 17; seed ^= seed << 5; seed >>>= 0; return seed / 4294967296 - 0.5; };
   const lines = ['#time,accel_x,accel_y,accel_z'];
   for (let k = 0; k < rows; k++) {
     const t = k / fs;
     let x = 0;
-    if (t >= 0.5) {
+    // Hits every 10 s from 5 s on (a decay near the record's start would fall under the
+    // first Welch window's taper).
+    const hit = t < 5 ? -1 : 5 + 10 * Math.floor((t - 5) / 10);
+    if (hit >= 0) {
       for (const m of MODES) {
         const w = 2 * Math.PI * m.f;
-        const tau = t - 0.5;
+        const tau = t - hit;
         x += m.a * Math.exp(-m.z * w * tau) * Math.sin(w * Math.sqrt(1 - m.z * m.z) * tau);
       }
     }
