@@ -1,19 +1,17 @@
 // Measured data (issue 7): load a recording, show its spectrum with the detected peaks, the
-// identified modes with their uncertainties, and the ranked shaper recommendation. The core
-// does the work (RecordingParser, identifyModes, recommendShaper, drawSpectrum); this module
-// reads the file in chunks so a 10⁶-row file never freezes the page, and keeps the last good
-// result on screen when a file is bad.
-import { RecordingParser, identifyModes, recommendShaper, drawSpectrum } from '../pkg/input_shaping.js';
+// identified modes with their uncertainties, and the ranked shaper recommendation. The reading
+// (in 1 MB chunks, with progress) and the analysis run in a worker (web/measure_worker.js), so
+// a 10⁶-row file never freezes the page; a bad file leaves the last good result on screen.
+import { drawSpectrum } from '../pkg/input_shaping.js';
 
 const $ = (id) => document.getElementById(id);
-/** Bytes read per step; the page yields to the browser between steps. */
-const CHUNK_BYTES = 1 << 20;
 /** Largest file accepted (a 10⁷-row Klipper file is ~350 MB). */
 const MAX_FILE_BYTES = 512 * 1024 * 1024;
 
-let recording = null; // the last good recording
-let identification = null; // and what was found in it
-let loadToken = 0;
+let worker = null;
+let identification = null; // the last good result
+let request = 0; // id of the latest request: older answers are ignored
+let fileName = '';
 let acceptModes = () => {};
 
 function el(tag, props = {}, ...children) {
@@ -27,92 +25,68 @@ function el(tag, props = {}, ...children) {
 }
 const fmt = (x, digits = 4) => (Number.isFinite(x) ? String(Number(x.toPrecision(digits))) : '—');
 const pct = (x) => (Number.isFinite(x) ? `${fmt(100 * x, 3)} %` : '—');
-const nextFrame = () => new Promise((resolve) => setTimeout(resolve, 0));
 const METHOD = { halfPower: 'half-power', spectrumFit: 'spectrum fit', freeDecay: 'free-decay fit' };
 
 function status(text) { $('measure-status').textContent = text; }
 function showError(text) { $('measure-error').textContent = text; }
 
-/** Reads `file` in chunks into a RecordingParser, with progress; returns the recording. */
-async function readRecording(file, token) {
-  if (file.size > MAX_FILE_BYTES) {
-    throw new Error(`${file.name} is ${(file.size / 1e6).toFixed(0)} MB; at most ${MAX_FILE_BYTES / 1e6} MB are read`);
-  }
-  const progress = $('measure-progress');
-  progress.hidden = false;
-  progress.value = 0;
-  const parser = new RecordingParser({});
-  const decoder = new TextDecoder('utf-8');
-  try {
-    for (let offset = 0; offset < file.size; offset += CHUNK_BYTES) {
-      const bytes = await file.slice(offset, offset + CHUNK_BYTES).arrayBuffer();
-      if (token !== loadToken) return null; // another file was chosen meanwhile
-      parser.push(decoder.decode(bytes, { stream: true }));
-      progress.value = Math.min(1, (offset + bytes.byteLength) / Math.max(1, file.size));
-      status(`Reading ${file.name}: ${parser.rows.toLocaleString('en')} rows…`);
-      await nextFrame();
-    }
-    parser.push(decoder.decode());
-    return parser.finish();
-  } finally {
-    parser.free();
-    progress.hidden = true;
-  }
-}
-
-async function load(file) {
-  const token = ++loadToken;
-  showError('');
-  try {
-    const rec = await readRecording(file, token);
-    if (!rec) return;
-    status(`Analysing ${rec.rows.toLocaleString('en')} samples…`);
-    await nextFrame();
-    const previous = recording;
-    recording = rec;
-    fillChannels(rec);
-    if (!analyse({ keepOnError: previous })) return;
-    $('measure-file-name').textContent = file.name;
-  } catch (e) {
-    showError(describe(file.name, e));
-    status(recording ? 'The previous recording is still shown.' : '');
-  }
-}
-
-/** "data.csv, line 12, column 3 (`accel_y`): `abc` is not a number". */
-function describe(name, e) {
-  const message = e?.message ?? String(e);
-  return `Could not read ${name}: ${message.replace(/^recording: /, '')}`;
-}
-
-function fillChannels(rec) {
-  const select = $('measure-channel');
-  const before = select.value;
-  select.replaceChildren(...rec.channels.map((c, i) => el('option', { value: String(i) }, c.name)));
-  const same = rec.channels.findIndex((c) => c.name === before);
-  select.value = String(same >= 0 ? same : 0);
-}
-
-/** Identifies and recommends for the current recording; false (and the old result kept) on error. */
-function analyse({ keepOnError = null } = {}) {
-  if (!recording) return false;
-  const options = {
+function options() {
+  return {
     channel: Number($('measure-channel').value || 0),
     signal: $('measure-signal').value,
     maxModes: Number($('measure-max-modes').value),
   };
-  let id;
-  let rec = null;
-  try {
-    id = identifyModes(recording, options);
-    if (id.modes.length > 0) rec = recommendShaper(id.spectrum, id.modes, {});
-  } catch (e) {
-    showError(`Could not analyse the recording: ${e?.message ?? e}`);
-    if (keepOnError) { recording = keepOnError; fillChannels(recording); }
-    return false;
+}
+
+function load(file) {
+  showError('');
+  if (file.size > MAX_FILE_BYTES) {
+    showError(`Could not read ${file.name}: it is ${(file.size / 1e6).toFixed(0)} MB; at most ${MAX_FILE_BYTES / 1e6} MB are read`);
+    return;
   }
+  fileName = file.name;
+  const progress = $('measure-progress');
+  progress.value = 0;
+  progress.hidden = false;
+  status(`Reading ${file.name}…`);
+  // A new file starts from its first channel.
+  worker.postMessage({ id: ++request, type: 'load', file, options: { ...options(), channel: 0 } });
+}
+
+function analyse() {
+  if (!identification) return;
+  worker.postMessage({ id: ++request, type: 'analyse', options: options() });
+}
+
+function onMessage({ data }) {
+  if (data.id !== request) return;
+  const progress = $('measure-progress');
+  if (data.type === 'progress') {
+    progress.value = data.fraction;
+    status(`Reading ${fileName}: ${data.rows.toLocaleString('en')} rows…`);
+  } else if (data.type === 'analysing') {
+    progress.hidden = true;
+    status(`Analysing ${data.rows.toLocaleString('en')} samples…`);
+  } else if (data.type === 'error') {
+    progress.hidden = true;
+    showError(`Could not read ${fileName}: ${data.message.replace(/^recording: /, '')}`);
+    status(identification ? 'The previous result is still shown.' : '');
+  } else if (data.type === 'result') {
+    progress.hidden = true;
+    show(data);
+    $('measure-file-name').textContent = fileName;
+  }
+}
+
+function fillChannels(names, selected) {
+  const select = $('measure-channel');
+  select.replaceChildren(...names.map((n, i) => el('option', { value: String(i) }, n)));
+  select.value = String(Math.max(0, names.indexOf(selected)));
+}
+
+function show({ recording: r, identification: id, recommendation: rec }) {
   identification = id;
-  const r = recording;
+  fillChannels(r.channels, id.channel);
   status(`${r.format === 'klipper' ? 'Klipper raw accelerometer file' : 'CSV'}: ${r.rows.toLocaleString('en')} samples `
     + `at ${fmt(r.sampleRateHz, 6)} Hz over ${fmt(r.durationS, 4)} s`
     + `${r.resampled ? ` (uneven time stamps, jitter ${pct(r.timing.jitter)}, resampled)` : ''}; channel ${id.channel}; `
@@ -121,7 +95,6 @@ function analyse({ keepOnError = null } = {}) {
   showModes(id);
   showRecommendation(rec);
   draw();
-  return true;
 }
 
 function showModes(id) {
@@ -175,6 +148,9 @@ function draw() {
 /** Wires the section; `hooks.acceptModes(modes)` puts modes into the playground's editor. */
 export function setupMeasure(hooks) {
   acceptModes = hooks.acceptModes;
+  worker = new Worker(new URL('./measure_worker.js', import.meta.url), { type: 'module' });
+  worker.addEventListener('message', onMessage);
+  worker.addEventListener('error', (e) => showError(`The measurement worker failed: ${e.message ?? e}`));
   const input = $('measure-file');
   input.addEventListener('change', () => {
     const file = input.files[0];

@@ -2,7 +2,8 @@
 // modes goes in through the file input; the identified modes must appear in the DOM within
 // 1 % / 15 %, "Use these modes" must put them into the modes editor, a bad file must give a
 // message naming line and column without losing the result, and a 10⁶-row file must load in
-// chunks with progress shown.
+// chunks with progress shown (reading and analysis run in a worker; the longest stall of the
+// page's own thread is printed, not asserted: no wall-clock bounds in tests).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { openBrowser, canvasInfo, SCREENSHOTS } from './browser.mjs';
@@ -104,10 +105,13 @@ test('a 10^6-row file loads in chunks with progress shown', async () => {
     new MutationObserver(() => { if (!p.hidden) window.__progress++; }).observe(p, { attributes: true });
     let last = performance.now();
     setInterval(() => { const now = performance.now(); window.__maxGap = Math.max(window.__maxGap, now - last); last = now; }, 10);
+    // Measured from the moment the page has the file (handing 42 MB over from the test
+    // driver blocks the page by itself).
+    document.getElementById('measure-file').addEventListener('change', () => { window.__maxGap = 0; last = performance.now(); });
   });
   const text = klipperFile(1_000_000);
   await loadFile(page, 'big.csv', text);
-  await page.waitForFunction(() => /1,000,000 samples/.test(document.getElementById('measure-status').textContent), null, { timeout: 240000 });
+  await page.waitForFunction(() => /^Klipper raw accelerometer file: 1,000,000 samples/.test(document.getElementById('measure-status').textContent), null, { timeout: 240000 });
   const { progress, maxGap } = await page.evaluate(() => ({ progress: window.__progress, maxGap: window.__maxGap }));
   console.log(`10^6 rows (${(text.length / 1e6).toFixed(1)} MB): ${progress} progress updates, longest stall ${maxGap.toFixed(0)} ms`);
   assert.ok(progress > 10, `progress shown in steps: ${progress}`);
