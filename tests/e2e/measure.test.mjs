@@ -27,9 +27,12 @@ function klipperFile(rows, fs = 3200) {
     const hit = t < 5 ? -1 : 5 + 10 * Math.floor((t - 5) / 10);
     if (hit >= 0) {
       for (const m of MODES) {
+        // The acceleration of an impulse response e^{−σt} sin(ω_d t) (over ω², so of height ≈ a).
         const w = 2 * Math.PI * m.f;
+        const s = m.z * w;
+        const wd = w * Math.sqrt(1 - m.z * m.z);
         const tau = t - hit;
-        x += m.a * Math.exp(-m.z * w * tau) * Math.sin(w * Math.sqrt(1 - m.z * m.z) * tau);
+        x += (m.a / (w * w)) * Math.exp(-s * tau) * ((s * s - wd * wd) * Math.sin(wd * tau) - 2 * s * wd * Math.cos(wd * tau));
       }
     }
     x += 20 * noise();
