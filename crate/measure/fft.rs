@@ -2,7 +2,7 @@
 //! to its few dependencies: iterative radix-2 Cooley–Tukey for powers of two, and Bluestein's
 //! chirp-z algorithm (a power-of-two convolution) for every other length.
 //!
-//! X[k] = Σₙ x[n] e^{−2πi kn/N} (the sign and scaling of numpy's `fft.fft`). Plans precompute the
+//! X_k = Σₙ xₙ e^{−2πi kn/N} (the sign and scaling of numpy's `fft.fft`). Plans precompute the
 //! twiddles and the bit-reversal table, so a Welch estimate reuses one plan for every segment.
 //! Accuracy: the twiddles are computed directly (not by recurrence), so the round-off error
 //! grows like O(ε log N); tests compare with the O(N²) definition.
@@ -250,8 +250,8 @@ impl Fft {
     }
 
     /// Transforms two real sequences of length N at once (as one complex sequence x + iy) and
-    /// returns their one-sided spectra X[k], Y[k] for k = 0 … N/2 (Hermitian symmetry:
-    /// X[k] = (Z[k] + conj Z[N−k])/2, Y[k] = (Z[k] − conj Z[N−k])/(2i)).
+    /// returns their one-sided spectra X_k, Y_k for k = 0 … N/2 (Hermitian symmetry:
+    /// X_k = (Z_k + conj Z_{N−k})/2, Y_k = (Z_k − conj Z_{N−k})/(2i)).
     pub fn forward_real_pair(
         &mut self,
         x: &[f64],
@@ -282,7 +282,7 @@ impl Fft {
     }
 }
 
-/// The DFT of a real sequence, one-sided: X[k] for k = 0 … ⌊N/2⌋ (numpy's `fft.rfft`).
+/// The DFT of a real sequence, one-sided: X_k for k = 0 … ⌊N/2⌋ (numpy's `fft.rfft`).
 pub fn rfft(x: &[f64]) -> Vec<Complex> {
     if x.is_empty() {
         return Vec::new();
