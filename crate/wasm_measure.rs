@@ -362,10 +362,14 @@ struct DrawOptions {
     peaks_hz: Vec<f64>,
     max_hz: Option<f64>,
     pixel_ratio: Option<f64>,
+    title: Option<String>,
+    y_label: Option<String>,
 }
 
-/// `drawSpectrum(canvas, spectrum, { peaksHz?, maxHz?, pixelRatio? })`: draws `spectrum =
-/// { frequencyHz, psd }` in dB on the canvas with a labelled marker at each of `peaksHz`.
+/// `drawSpectrum(canvas, spectrum, { peaksHz?, maxHz?, pixelRatio?, title?, yLabel? })`: draws
+/// `spectrum = { frequencyHz, psd }` in dB (10·log₁₀ psd) on the canvas with a labelled marker
+/// at each of `peaksHz`; `title` / `yLabel` default to "Measured spectrum (Welch PSD)" /
+/// "PSD (dB)" (pass |X|² as `psd` to draw an FFT magnitude in dB).
 #[wasm_bindgen(js_name = drawSpectrum)]
 pub fn draw_spectrum(
     canvas: HtmlCanvasElement,
@@ -391,12 +395,19 @@ pub fn draw_spectrum(
             reason: "the canvas has no 2D context".into(),
         })
     })?;
+    let titles = (
+        o.title.as_deref().unwrap_or(chart::spectrum::PSD_TITLES.0),
+        o.y_label
+            .as_deref()
+            .unwrap_or(chart::spectrum::PSD_TITLES.1),
+    );
     chart::draw_spectrum(
         &backend.into_drawing_area(),
         &f,
         &p,
         &peaks,
         o.max_hz,
+        titles,
         &style,
     )
     .map_err(js_error)

@@ -2,6 +2,7 @@
 //! canvas.
 #![cfg(not(target_arch = "wasm32"))]
 
+use input_shaping::chart::spectrum::PSD_TITLES;
 use input_shaping::chart::{draw_spectrum, ChartStyle};
 use plotters::prelude::*;
 
@@ -28,7 +29,16 @@ fn spectrum_chart_marks_and_labels_each_peak() {
     let mut out = String::new();
     {
         let area = SVGBackend::with_string(&mut out, (640, 360)).into_drawing_area();
-        draw_spectrum(&area, &f, &p, &peaks, Some(150.0), &ChartStyle::default()).unwrap();
+        draw_spectrum(
+            &area,
+            &f,
+            &p,
+            &peaks,
+            Some(150.0),
+            PSD_TITLES,
+            &ChartStyle::default(),
+        )
+        .unwrap();
     }
     let t = texts(&out);
     for want in [
@@ -61,6 +71,7 @@ fn spectrum_chart_rejects_mismatched_data() {
         &[1.0],
         &[],
         None,
+        PSD_TITLES,
         &ChartStyle::default()
     )
     .is_err());

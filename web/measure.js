@@ -10,6 +10,7 @@ const MAX_FILE_BYTES = 512 * 1024 * 1024;
 
 let worker = null;
 let identification = null; // the last good result
+let fft = null; // the FFT magnitude of the current channel, when shown
 let request = 0; // id of the latest request: older answers are ignored
 let fileName = '';
 let acceptModes = () => {};
@@ -71,11 +72,21 @@ function onMessage({ data }) {
     progress.hidden = true;
     showError(`Could not read ${fileName}: ${data.message.replace(/^recording: /, '')}`);
     status(identification ? 'The previous result is still shown.' : '');
+  } else if (data.type === 'fft') {
+    fft = data.spectrum;
+    draw();
   } else if (data.type === 'result') {
     progress.hidden = true;
+    fft = null;
     show(data);
+    if ($('measure-view').value === 'fft') requestFft();
     $('measure-file-name').textContent = fileName;
   }
+}
+
+function requestFft() {
+  if (!identification) return;
+  worker.postMessage({ id: request, type: 'fft', channel: Number($('measure-channel').value || 0) });
 }
 
 function fillChannels(names, selected) {
@@ -136,9 +147,11 @@ function draw() {
   canvas.height = Math.round(width * 0.42 * ratio);
   const top = Math.max(0, ...identification.modes.map((m) => m.frequencyHz));
   const maxHz = top > 0 ? Math.min(identification.spectrum.sampleRateHz / 2, 2.5 * top) : undefined;
+  const showFft = $('measure-view').value === 'fft' && fft;
   try {
-    drawSpectrum(canvas, identification.spectrum, {
+    drawSpectrum(canvas, showFft ? fft : identification.spectrum, {
       peaksHz: identification.modes.map((m) => m.frequencyHz), maxHz, pixelRatio: ratio,
+      ...(showFft ? { title: 'Measured spectrum (FFT magnitude of the whole record)', yLabel: '|X|² (dB)' } : {}),
     });
   } catch (e) {
     showError(`Could not draw the spectrum: ${e?.message ?? e}`);
@@ -169,6 +182,10 @@ export function setupMeasure(hooks) {
   for (const id of ['measure-channel', 'measure-signal', 'measure-max-modes']) {
     $(id).addEventListener('change', () => { showError(''); analyse(); });
   }
+  $('measure-view').addEventListener('change', () => {
+    if ($('measure-view').value === 'fft' && !fft) requestFft();
+    else draw();
+  });
   $('measure-accept').addEventListener('click', () => {
     if (!identification || identification.modes.length === 0) return;
     acceptModes(identification.modes.map((m) => ({

@@ -1,8 +1,9 @@
 // The measured-data worker: reads a recording in chunks, identifies the modes and ranks the
 // shapers off the page's thread, so a 10⁶-row file never freezes the page. Messages in:
-// { id, type: 'load', file, options } and { id, type: 'analyse', options }; out: progress,
-// result ({ recording, identification, recommendation }) or error ({ message, line, column }).
-import init, { RecordingParser, identifyModes, recommendShaper } from '../pkg/input_shaping.js';
+// { id, type: 'load', file, options }, { id, type: 'analyse', options } and { id, type: 'fft',
+// channel }; out: progress, result ({ recording, identification, recommendation }), fft
+// ({ spectrum }) or error ({ message, line, column }).
+import init, { RecordingParser, identifyModes, recommendShaper, fftSpectrum } from '../pkg/input_shaping.js';
 
 const CHUNK_BYTES = 1 << 20;
 const ready = init();
@@ -49,6 +50,12 @@ onmessage = async ({ data }) => {
       postMessage(result);
     } else if (data.type === 'analyse' && recording) {
       postMessage(analyse(id, recording, data.options));
+    } else if (data.type === 'fft' && recording) {
+      // The plain FFT magnitude of the whole channel (at most 2^22 samples), as |X|² for the chart.
+      const values = recording.channels[data.channel]?.values ?? recording.channels[0].values;
+      const s = fftSpectrum(values, { sampleRateHz: recording.sampleRateHz });
+      const power = s.magnitude.map((m) => m * m);
+      postMessage({ id, type: 'fft', spectrum: { frequencyHz: s.frequencyHz, psd: power } }, [power.buffer]);
     }
   } catch (e) {
     postMessage({ id, type: 'error', message: e?.message ?? String(e), line: e?.line, column: e?.column });

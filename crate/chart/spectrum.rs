@@ -10,8 +10,12 @@ use plotters::prelude::*;
 /// never lost between pixels.
 pub const MAX_DRAWN_POINTS: usize = 2000;
 
+/// Caption and y-axis label of a Welch PSD.
+pub const PSD_TITLES: (&str, &str) = ("Measured spectrum (Welch PSD)", "PSD (dB)");
+
 /// Draws `psd` (linear units²/Hz, drawn as 10·log₁₀) against `frequency_hz` up to `max_hz`
 /// (all of it if `None`), and a marker with a label at each `(frequency, label)` of `peaks`.
+/// `titles` = (caption, y-axis label); the default is [`PSD_TITLES`].
 ///
 /// Errors: `frequency_hz` and `psd` of different lengths or empty.
 pub fn draw_spectrum<DB: DrawingBackend>(
@@ -20,6 +24,7 @@ pub fn draw_spectrum<DB: DrawingBackend>(
     psd: &[f64],
     peaks: &[(f64, String)],
     max_hz: Option<f64>,
+    titles: (&str, &str),
     style: &ChartStyle,
 ) -> Result<()> {
     if frequency_hz.len() != psd.len() || psd.is_empty() {
@@ -81,7 +86,7 @@ pub fn draw_spectrum<DB: DrawingBackend>(
     chart
         .configure_mesh()
         .x_desc("frequency (Hz)")
-        .y_desc("PSD (dB)")
+        .y_desc(titles.1)
         .label_style(("sans-serif", style.font(12.0)))
         .axis_desc_style(("sans-serif", style.font(13.0)))
         .light_line_style(RGBColor(238, 238, 238))
