@@ -62,6 +62,29 @@ fn spectrum_chart_marks_and_labels_each_peak() {
 }
 
 #[test]
+fn spectrum_chart_takes_its_titles() {
+    let mut out = String::new();
+    {
+        let area = SVGBackend::with_string(&mut out, (320, 200)).into_drawing_area();
+        draw_spectrum(
+            &area,
+            &[0.0, 1.0, 2.0],
+            &[1.0, 2.0, 1.0],
+            &[],
+            None,
+            ("FFT", "|X|² (dB)"),
+            &ChartStyle::default(),
+        )
+        .unwrap();
+    }
+    let t = texts(&out);
+    assert!(
+        t.contains(&"FFT".to_string()) && t.contains(&"|X|² (dB)".to_string()),
+        "{t:?}"
+    );
+}
+
+#[test]
 fn spectrum_chart_rejects_mismatched_data() {
     let mut out = String::new();
     let area = SVGBackend::with_string(&mut out, (100, 100)).into_drawing_area();

@@ -148,6 +148,7 @@ function draw() {
   const top = Math.max(0, ...identification.modes.map((m) => m.frequencyHz));
   const maxHz = top > 0 ? Math.min(identification.spectrum.sampleRateHz / 2, 2.5 * top) : undefined;
   const showFft = $('measure-view').value === 'fft' && fft;
+  canvas.dataset.view = showFft ? 'fft' : 'welch';
   try {
     drawSpectrum(canvas, showFft ? fft : identification.spectrum, {
       peaksHz: identification.modes.map((m) => m.frequencyHz), maxHz, pixelRatio: ratio,

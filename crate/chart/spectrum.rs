@@ -74,10 +74,7 @@ pub fn draw_spectrum<DB: DrawingBackend>(
     y_lo = y_lo.max(y_hi - 120.0);
     let pad = 0.08 * (y_hi - y_lo).max(1.0);
     let mut chart = ChartBuilder::on(area)
-        .caption(
-            "Measured spectrum (Welch PSD)",
-            ("sans-serif", style.font(16.0)),
-        )
+        .caption(titles.0, ("sans-serif", style.font(16.0)))
         .margin(style.px(10.0))
         .x_label_area_size(style.px(40.0))
         .y_label_area_size(style.px(56.0))
