@@ -31,13 +31,17 @@
 //!   bisection on the duration, Newton polish, dense checks) shared by the solved families.
 //! - [`chart`]: charts drawn with plotters on any backend (canvas in the page, SVG in tests).
 //! - [`error`]: the one error type; nothing reachable from the public API panics.
-//! - `wasm` (wasm32 only): the JavaScript API (`design`, `residualVibration`, `sensitivity`, …).
+//! - [`measure`]: measured data — recordings, FFT and Welch PSD, mode identification with
+//!   uncertainties, shaper recommendation over the measured spectrum.
+//! - `wasm` (wasm32 only): the JavaScript API (`design`, `residualVibration`, `sensitivity`, …);
+//!   `wasm_measure`: its measured-data part (`parseRecording`, `welch`, `identifyModes`, …).
 
 pub mod chart;
 pub mod command;
 pub mod design;
 pub mod error;
 pub mod export;
+pub mod measure;
 pub mod metrics;
 pub mod mode;
 pub mod plant;
@@ -54,6 +58,8 @@ pub mod vibration;
 mod canvas;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
+#[cfg(target_arch = "wasm32")]
+pub mod wasm_measure;
 
 pub use design::{design, DesignRequest, ShaperSpec};
 pub use error::{Error, Result};

@@ -31,7 +31,7 @@ pub fn start() {
 }
 
 /// Converts a crate error into a thrown JS `Error` carrying `field` and `kind`.
-fn js_error(error: Error) -> JsValue {
+pub(crate) fn js_error(error: Error) -> JsValue {
     let e = js_sys::Error::new(&error.to_string());
     let kind = match &error {
         Error::InvalidInput { .. } => "invalid",
@@ -48,7 +48,7 @@ fn js_error(error: Error) -> JsValue {
 }
 
 /// Reads a JS value into `T`, naming the path of a bad field under `what`.
-fn from_js<T: DeserializeOwned>(value: JsValue, what: &str) -> Result<T, Error> {
+pub(crate) fn from_js<T: DeserializeOwned>(value: JsValue, what: &str) -> Result<T, Error> {
     if value.is_undefined() || value.is_null() {
         return Err(Error::Parse {
             field: what.to_string(),
@@ -70,7 +70,7 @@ fn from_js<T: DeserializeOwned>(value: JsValue, what: &str) -> Result<T, Error> 
 }
 
 /// Writes `value` to a plain JS object (maps as objects, not `Map`).
-fn to_js<T: Serialize>(value: &T) -> Result<JsValue, JsValue> {
+pub(crate) fn to_js<T: Serialize>(value: &T) -> Result<JsValue, JsValue> {
     value
         .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
         .map_err(|e| {
@@ -128,7 +128,7 @@ pub fn insensitivity(shaper: JsValue, mode: JsValue, vtol: f64) -> Result<JsValu
 }
 
 /// Sets `object[key] = value`, reporting a failure as a render error.
-fn set(object: &js_sys::Object, key: &str, value: &JsValue) -> Result<(), JsValue> {
+pub(crate) fn set(object: &js_sys::Object, key: &str, value: &JsValue) -> Result<(), JsValue> {
     js_sys::Reflect::set(object, &key.into(), value)
         .map(|_| ())
         .map_err(|_| {

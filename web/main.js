@@ -6,6 +6,7 @@ import init, { renderPlayground, families, exportShaper } from '../pkg/input_sha
 import { DEFAULT_STATE, PRESETS, MAX_MODES, MAX_SHAPERS, checkState, clone, toHash, fromHash } from './state.js';
 import { COMMAND_PARAMS, commandFor } from './params.js';
 import { paramInfo, parseParam, formatParam } from './params.js';
+import { setupMeasure } from './measure.js';
 
 const $ = (id) => document.getElementById(id);
 const COLORS = ['#0072b2', '#d55e00', '#009e73', '#cc79a7'];
@@ -433,6 +434,8 @@ async function main() {
   let resizeTimer;
   window.addEventListener('resize', () => { clearTimeout(resizeTimer); resizeTimer = setTimeout(update, 100); });
   fromLocation({ startup: true });
+  // Measured data: identified modes replace the editor's modes with one click.
+  setupMeasure({ acceptModes(modes) { state.modes = modes.slice(0, MAX_MODES); rebuild(); changed(true); } });
   // For the benchmark script: a full update, timed.
   window.__playground = { update, get state() { return state; } };
 }

@@ -1,0 +1,671 @@
+//! Reading a recording: CSV text with a time column and one or more signal columns.
+//!
+//! - Klipper's raw accelerometer files (`ACCELEROMETER_MEASURE`, `TEST_RESONANCES` with raw
+//!   output) are read as they are: a header `#time,accel_x,accel_y,accel_z`, then one row per
+//!   sample, times in seconds.
+//! - Any other CSV: the first line that is not a `#` comment names the columns (a leading `#`
+//!   is allowed, as in Klipper's files); one column is the time — named `time`, `t`,
+//!   `timestamp`, `time_s`, `seconds` … (case-insensitive; or any name given as
+//!   `timeColumn`) — and every other column is a signal. Separators: comma, semicolon, tab or
+//!   blanks (guessed from the header). Blank lines and later `#` lines are skipped.
+//!
+//! Times must increase strictly. When they are not evenly spaced (a step differs from the mean
+//! by more than 0.1 % of it and more than 1.01 µs — the rounding of Klipper's 6-decimal times —
+//! as with accelerometers read in batches) the signals are resampled onto an even
+//! grid t₀ + k/f_s, f_s = (n − 1)/(t_last − t₀), by cubic Hermite interpolation (slopes of the
+//! parabola through three neighbours); the
+//! sample rate and the timing statistics are reported either way.
+//!
+//! Text can be fed in chunks ([`RecordingParser::push`]), so a page can read a large file
+//! piece by piece and show progress. Every error names the line (1-based) and, where it
+//! applies, the column (1-based, with its header name).
+
+use crate::error::Error;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// Most data rows accepted (10⁷; a 10⁶-row Klipper file is ~35 MB).
+pub const MAX_ROWS: usize = 10_000_000;
+/// Most columns accepted.
+pub const MAX_COLUMNS: usize = 64;
+/// Longest line accepted, in bytes.
+pub const MAX_LINE_BYTES: usize = 65_536;
+
+/// Names recognised as the time column (compared case-insensitively, after trimming).
+pub const TIME_NAMES: &[&str] = &[
+    "time",
+    "t",
+    "times",
+    "timestamp",
+    "time_s",
+    "time[s]",
+    "time (s)",
+    "time(s)",
+    "seconds",
+    "sec",
+    "s",
+];
+
+/// Options of the parser (JS: `{ timeColumn, timeScale }`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", default)]
+pub struct RecordingOptions {
+    /// Name of the time column, when it is not one of [`TIME_NAMES`].
+    pub time_column: Option<String>,
+    /// Factor turning the time column into seconds (default 1; 0.001 for milliseconds).
+    pub time_scale: f64,
+}
+
+impl Default for RecordingOptions {
+    fn default() -> Self {
+        RecordingOptions {
+            time_column: None,
+            time_scale: 1.0,
+        }
+    }
+}
+
+/// Which kind of file it was.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub enum RecordingFormat {
+    /// Klipper's raw accelerometer CSV (`#time,accel_x,accel_y,accel_z`).
+    Klipper,
+    /// Any other CSV with a time column.
+    Csv,
+}
+
+/// One signal column.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Channel {
+    /// The header name.
+    pub name: String,
+    /// Samples on the even grid (resampled if the file's times were uneven).
+    pub values: Vec<f64>,
+}
+
+/// How the file's time stamps were spaced.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Timing {
+    /// Mean step (t_last − t₀)/(n − 1), s.
+    pub mean_step_s: f64,
+    /// Smallest step, s.
+    pub min_step_s: f64,
+    /// Largest step, s (a gap in the recording shows here).
+    pub max_step_s: f64,
+    /// Standard deviation of the steps divided by the mean step.
+    pub jitter: f64,
+}
+
+/// A parsed recording on an even time grid.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Recording {
+    /// Klipper or generic CSV.
+    pub format: RecordingFormat,
+    /// Name of the time column.
+    pub time_column: String,
+    /// The signal columns, in file order.
+    pub channels: Vec<Channel>,
+    /// Sample rate of the even grid, Hz.
+    pub sample_rate_hz: f64,
+    /// Time of the first sample, s.
+    pub start_time_s: f64,
+    /// t_last − t₀, s.
+    pub duration_s: f64,
+    /// Number of samples (data rows).
+    pub rows: usize,
+    /// Whether the signals were resampled because the times were uneven.
+    pub resampled: bool,
+    /// Spacing statistics of the file's time stamps.
+    pub timing: Timing,
+    /// The time of each sample, s: the file's own when they were even, else the grid
+    /// t₀ + k/f_s. Not serialised (the JS API returns the channels only).
+    #[serde(skip)]
+    pub time_s: Vec<f64>,
+}
+
+impl Recording {
+    /// The channel called `name`.
+    pub fn channel(&self, name: &str) -> Option<&Channel> {
+        self.channels.iter().find(|c| c.name == name)
+    }
+
+    /// The time of each sample, s (see [`Recording::time_s`]).
+    pub fn time(&self) -> &[f64] {
+        &self.time_s
+    }
+}
+
+/// A parse error at a place in the file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordingError {
+    /// 1-based line number (0 when the error concerns the file as a whole).
+    pub line: usize,
+    /// 1-based column number, when the error concerns one field.
+    pub column: Option<usize>,
+    /// The column's header name, when known.
+    pub column_name: Option<String>,
+    /// What is wrong, in words.
+    pub reason: String,
+    /// Too-large errors (rows, columns, line length) are reported as [`Error::TooLarge`].
+    pub too_large: Option<(f64, f64)>,
+}
+
+impl RecordingError {
+    fn at(line: usize, reason: impl Into<String>) -> Self {
+        RecordingError {
+            line,
+            column: None,
+            column_name: None,
+            reason: reason.into(),
+            too_large: None,
+        }
+    }
+    fn field(line: usize, column: usize, name: &str, reason: impl Into<String>) -> Self {
+        RecordingError {
+            line,
+            column: Some(column),
+            column_name: Some(name.to_string()),
+            reason: reason.into(),
+            too_large: None,
+        }
+    }
+    /// "line 12, column 3 (`accel_y`)" — where the error is.
+    pub fn location(&self) -> String {
+        let mut s = if self.line > 0 {
+            format!("line {}", self.line)
+        } else {
+            "recording".to_string()
+        };
+        if let Some(c) = self.column {
+            s.push_str(&format!(", column {c}"));
+            if let Some(n) = &self.column_name {
+                s.push_str(&format!(" (`{n}`)"));
+            }
+        }
+        s
+    }
+}
+
+impl fmt::Display for RecordingError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.location(), self.reason)
+    }
+}
+
+impl From<RecordingError> for Error {
+    fn from(e: RecordingError) -> Error {
+        match e.too_large {
+            Some((value, limit)) => Error::TooLarge {
+                field: format!("recording ({})", e.location()),
+                value,
+                limit,
+            },
+            None => Error::Parse {
+                field: "recording".into(),
+                reason: e.to_string(),
+            },
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Separator {
+    Char(char),
+    Blank,
+}
+
+#[derive(Debug, Clone)]
+struct Header {
+    names: Vec<String>,
+    time: usize,
+    separator: Separator,
+    klipper: bool,
+}
+
+/// An incremental CSV reader: [`push`](RecordingParser::push) text in chunks of any size
+/// (lines may span chunks), then [`finish`](RecordingParser::finish).
+#[derive(Debug, Clone)]
+pub struct RecordingParser {
+    options: RecordingOptions,
+    pending: String,
+    line: usize,
+    header: Option<Header>,
+    times: Vec<f64>,
+    columns: Vec<Vec<f64>>,
+    failed: Option<RecordingError>,
+    header_line_seen: usize,
+}
+
+fn split(line: &str, sep: Separator) -> Vec<&str> {
+    match sep {
+        Separator::Char(c) => line.split(c).map(str::trim).collect(),
+        Separator::Blank => line.split_whitespace().collect(),
+    }
+}
+
+fn is_time_name(name: &str, wanted: Option<&str>) -> bool {
+    match wanted {
+        Some(w) => name.trim().eq_ignore_ascii_case(w.trim()),
+        None => TIME_NAMES.iter().any(|n| name.eq_ignore_ascii_case(n)),
+    }
+}
+
+impl RecordingParser {
+    /// A parser with `options`.
+    pub fn new(options: RecordingOptions) -> Self {
+        RecordingParser {
+            options,
+            pending: String::new(),
+            line: 0,
+            header: None,
+            times: Vec::new(),
+            columns: Vec::new(),
+            failed: None,
+            header_line_seen: 0,
+        }
+    }
+
+    /// Lines read so far.
+    pub fn lines(&self) -> usize {
+        self.line
+    }
+
+    /// Data rows read so far.
+    pub fn rows(&self) -> usize {
+        self.times.len()
+    }
+
+    /// Reads a chunk of text. After an error every further call returns the same error.
+    pub fn push(&mut self, chunk: &str) -> Result<(), RecordingError> {
+        if let Some(e) = &self.failed {
+            return Err(e.clone());
+        }
+        let result = self.push_inner(chunk);
+        if let Err(e) = &result {
+            self.failed = Some(e.clone());
+        }
+        result
+    }
+
+    fn push_inner(&mut self, chunk: &str) -> Result<(), RecordingError> {
+        let mut rest = chunk;
+        while let Some(i) = rest.find('\n') {
+            let (head, tail) = rest.split_at(i);
+            rest = &tail[1..];
+            if self.pending.is_empty() {
+                self.line(head)?;
+            } else {
+                let mut full = std::mem::take(&mut self.pending);
+                full.push_str(head);
+                self.line(&full)?;
+            }
+        }
+        self.pending.push_str(rest);
+        if self.pending.len() > MAX_LINE_BYTES {
+            let mut e = RecordingError::at(
+                self.line + 1,
+                format!("the line is longer than {MAX_LINE_BYTES} bytes — is this a CSV file?"),
+            );
+            e.too_large = Some((self.pending.len() as f64, MAX_LINE_BYTES as f64));
+            return Err(e);
+        }
+        Ok(())
+    }
+
+    fn line(&mut self, raw: &str) -> Result<(), RecordingError> {
+        self.line += 1;
+        let n = self.line;
+        if raw.len() > MAX_LINE_BYTES {
+            let mut e = RecordingError::at(
+                n,
+                format!("the line is longer than {MAX_LINE_BYTES} bytes — is this a CSV file?"),
+            );
+            e.too_large = Some((raw.len() as f64, MAX_LINE_BYTES as f64));
+            return Err(e);
+        }
+        let text = raw.trim_end_matches('\r').trim();
+        let text = if n == 1 {
+            text.trim_start_matches('\u{feff}')
+        } else {
+            text
+        };
+        if text.is_empty() {
+            return Ok(());
+        }
+        let Some(header) = &self.header else {
+            return self.header_line(text);
+        };
+        if text.starts_with('#') {
+            return Ok(());
+        }
+        let fields = split(text, header.separator);
+        let count = if fields.len() == header.names.len() + 1 && fields.last() == Some(&"") {
+            header.names.len()
+        } else {
+            fields.len()
+        };
+        if count != header.names.len() {
+            return Err(RecordingError::at(
+                n,
+                format!(
+                    "{} values, but the header on line {} names {} columns",
+                    fields.len(),
+                    self.header_line_number(),
+                    header.names.len()
+                ),
+            ));
+        }
+        if self.times.len() >= MAX_ROWS {
+            let mut e = RecordingError::at(n, format!("more than {MAX_ROWS} data rows"));
+            e.too_large = Some(((MAX_ROWS + 1) as f64, MAX_ROWS as f64));
+            return Err(e);
+        }
+        let mut signal = 0;
+        for (j, field) in fields.iter().take(count).enumerate() {
+            let name = &header.names[j];
+            if field.is_empty() {
+                return Err(RecordingError::field(n, j + 1, name, "the value is empty"));
+            }
+            let value: f64 = field.parse().map_err(|_| {
+                RecordingError::field(n, j + 1, name, format!("`{field}` is not a number"))
+            })?;
+            if !value.is_finite() {
+                return Err(RecordingError::field(
+                    n,
+                    j + 1,
+                    name,
+                    format!("`{field}` is not a finite number"),
+                ));
+            }
+            if j == header.time {
+                let t = value * self.options.time_scale;
+                if let Some(&prev) = self.times.last() {
+                    if t <= prev {
+                        return Err(RecordingError::field(
+                            n,
+                            j + 1,
+                            name,
+                            format!(
+                                "time {field} does not increase (the previous row has {})",
+                                prev / self.options.time_scale
+                            ),
+                        ));
+                    }
+                }
+                self.times.push(t);
+            } else {
+                self.columns[signal].push(value);
+                signal += 1;
+            }
+        }
+        Ok(())
+    }
+
+    fn header_line_number(&self) -> usize {
+        // Only used in messages: the header is the first line that made `header` Some.
+        self.header_line_seen
+    }
+
+    fn header_line(&mut self, text: &str) -> Result<(), RecordingError> {
+        let n = self.line;
+        let commented = text.starts_with('#');
+        let body = text.trim_start_matches('#').trim();
+        let separator = if body.contains(',') {
+            Separator::Char(',')
+        } else if body.contains(';') {
+            Separator::Char(';')
+        } else if body.contains('\t') {
+            Separator::Char('\t')
+        } else {
+            Separator::Blank
+        };
+        let names: Vec<String> = split(body, separator)
+            .into_iter()
+            .map(|s| s.trim_matches('"').to_string())
+            .collect();
+        let wanted = self.options.time_column.as_deref();
+        let time = names.iter().position(|s| is_time_name(s, wanted));
+        let Some(time) = time else {
+            if commented {
+                return Ok(()); // a comment before the header
+            }
+            let numeric = names.iter().all(|s| s.parse::<f64>().is_ok());
+            let reason = if numeric {
+                "no header: the first line must name the columns, one of them the time \
+                 (e.g. `time,accel_x,accel_y,accel_z`)"
+                    .to_string()
+            } else {
+                let listed = names
+                    .iter()
+                    .map(|s| format!("`{s}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                match wanted {
+                    Some(w) => format!("no column named `{w}` (the header has {listed})"),
+                    None => format!(
+                        "no time column in the header ({listed}); name it `time` or give \
+                         its name as the timeColumn option"
+                    ),
+                }
+            };
+            return Err(RecordingError::at(n, reason));
+        };
+        if names.len() < 2 {
+            return Err(RecordingError::at(
+                n,
+                "the header names only a time column; at least one signal column is needed",
+            ));
+        }
+        if names.len() > MAX_COLUMNS {
+            let mut e = RecordingError::at(n, format!("more than {MAX_COLUMNS} columns"));
+            e.too_large = Some((names.len() as f64, MAX_COLUMNS as f64));
+            return Err(e);
+        }
+        if let Some((j, name)) = names.iter().enumerate().find(|(_, s)| s.is_empty()) {
+            return Err(RecordingError::field(
+                n,
+                j + 1,
+                name,
+                "the header leaves this column unnamed",
+            ));
+        }
+        if !(self.options.time_scale.is_finite() && self.options.time_scale > 0.0) {
+            return Err(RecordingError::at(
+                0,
+                format!(
+                    "timeScale must be a positive number, got {}",
+                    self.options.time_scale
+                ),
+            ));
+        }
+        let klipper = names.len() == 4
+            && names
+                .iter()
+                .zip(["time", "accel_x", "accel_y", "accel_z"])
+                .all(|(a, b)| a == b);
+        self.columns = vec![Vec::new(); names.len() - 1];
+        self.header = Some(Header {
+            names,
+            time,
+            separator,
+            klipper,
+        });
+        self.header_line_seen = n;
+        Ok(())
+    }
+
+    /// Reads whatever is left, checks the recording and puts it on an even grid.
+    pub fn finish(mut self) -> Result<Recording, RecordingError> {
+        if let Some(e) = self.failed.take() {
+            return Err(e);
+        }
+        if !self.pending.is_empty() {
+            let last = std::mem::take(&mut self.pending);
+            self.line(&last)?;
+        }
+        let Some(header) = self.header.take() else {
+            return Err(RecordingError::at(
+                self.line.max(1),
+                if self.line == 0 {
+                    "the file is empty"
+                } else {
+                    "the file has no header line naming the columns"
+                },
+            ));
+        };
+        let n = self.times.len();
+        if n < 2 {
+            return Err(RecordingError::at(
+                self.line.max(1),
+                format!(
+                    "{} data row{}: at least 2 are needed (a spectrum needs many more)",
+                    n,
+                    if n == 1 { "" } else { "s" }
+                ),
+            ));
+        }
+        let t0 = self.times[0];
+        let duration = self.times[n - 1] - t0;
+        let mean = duration / (n - 1) as f64;
+        let (mut lo, mut hi, mut ss) = (f64::INFINITY, 0.0_f64, 0.0);
+        for w in self.times.windows(2) {
+            let d = w[1] - w[0];
+            lo = lo.min(d);
+            hi = hi.max(d);
+            ss += (d - mean) * (d - mean);
+        }
+        let jitter = (ss / (n - 1) as f64).sqrt() / mean;
+        // Steps that differ by no more than the rounding of 6-decimal times (Klipper writes
+        // `%.6f`: two roundings of 0.5 µs) or 0.1 % are even.
+        let uneven = (hi - mean).max(mean - lo) > (1e-3 * mean).max(1.01e-6);
+        let names = header.names;
+        let channels = self
+            .columns
+            .into_iter()
+            .zip(names.iter().enumerate().filter(|(j, _)| *j != header.time))
+            .map(|(values, (_, name))| Channel {
+                name: name.clone(),
+                values: if uneven {
+                    resample(&self.times, &values, mean)
+                } else {
+                    values
+                },
+            })
+            .collect();
+        Ok(Recording {
+            format: if header.klipper {
+                RecordingFormat::Klipper
+            } else {
+                RecordingFormat::Csv
+            },
+            time_column: names[header.time].clone(),
+            channels,
+            sample_rate_hz: 1.0 / mean,
+            start_time_s: t0,
+            duration_s: duration,
+            rows: n,
+            resampled: uneven,
+            timing: Timing {
+                mean_step_s: mean,
+                min_step_s: lo,
+                max_step_s: hi,
+                jitter,
+            },
+            time_s: if uneven {
+                (0..n).map(|k| t0 + k as f64 * mean).collect()
+            } else {
+                self.times
+            },
+        })
+    }
+}
+
+/// Cubic Hermite interpolation of (t, v) onto t₀ + k·step, k < t.len(): exact at the samples,
+/// continuous slope, third order on smooth signals on an uneven grid.
+fn resample(t: &[f64], v: &[f64], step: f64) -> Vec<f64> {
+    let n = t.len();
+    let t0 = t[0];
+    let mut j = 0; // t[j] ≤ x < t[j+1]
+    (0..n)
+        .map(|k| {
+            let x = if k + 1 == n {
+                t[n - 1]
+            } else {
+                t0 + k as f64 * step
+            };
+            while j + 2 < n && t[j + 1] <= x {
+                j += 1;
+            }
+            let (ta, tb) = (t[j], t[j + 1]);
+            let h = tb - ta;
+            let s = ((x - ta) / h).clamp(0.0, 1.0);
+            // Slopes of the parabola through three neighbours (exact for quadratics on an
+            // uneven grid; one-sided at the ends).
+            let slope = |i: usize| -> f64 {
+                if i == 0 {
+                    (v[1] - v[0]) / (t[1] - t[0])
+                } else if i + 1 == n {
+                    (v[n - 1] - v[n - 2]) / (t[n - 1] - t[n - 2])
+                } else {
+                    let (hl, hr) = (t[i] - t[i - 1], t[i + 1] - t[i]);
+                    (hl * hl * (v[i + 1] - v[i]) + hr * hr * (v[i] - v[i - 1]))
+                        / (hl * hr * (hl + hr))
+                }
+            };
+            let (ma, mb) = (slope(j) * h, slope(j + 1) * h);
+            let s2 = s * s;
+            let s3 = s2 * s;
+            (2.0 * s3 - 3.0 * s2 + 1.0) * v[j]
+                + (s3 - 2.0 * s2 + s) * ma
+                + (-2.0 * s3 + 3.0 * s2) * v[j + 1]
+                + (s3 - s2) * mb
+        })
+        .collect()
+}
+
+/// Parses a whole recording at once (see the module docs).
+pub fn parse_recording(
+    text: &str,
+    options: &RecordingOptions,
+) -> Result<Recording, RecordingError> {
+    let mut parser = RecordingParser::new(options.clone());
+    parser.push(text)?;
+    parser.finish()
+}
+
+/// Writes a recording as CSV: Klipper's raw format (`#time,accel_x,accel_y,accel_z`, values
+/// with 6 decimals, as Klipper's `write_to_file`) when `format` is Klipper, else a header
+/// `time,<names>` and values with 10 significant digits. Times are [`Recording::time_s`].
+pub fn write_csv(recording: &Recording) -> String {
+    let mut out = String::with_capacity(recording.rows * 12 * (recording.channels.len() + 1));
+    let klipper = recording.format == RecordingFormat::Klipper;
+    if klipper {
+        out.push('#');
+    }
+    out.push_str(&recording.time_column);
+    for c in &recording.channels {
+        out.push(',');
+        out.push_str(&c.name);
+    }
+    out.push('\n');
+    use std::fmt::Write;
+    for (k, &t) in recording.time_s.iter().enumerate() {
+        if klipper {
+            let _ = write!(out, "{t:.6}");
+            for c in &recording.channels {
+                let _ = write!(out, ",{:.6}", c.values[k]);
+            }
+        } else {
+            let _ = write!(out, "{t:.9e}");
+            for c in &recording.channels {
+                let _ = write!(out, ",{:.9e}", c.values[k]);
+            }
+        }
+        out.push('\n');
+    }
+    out
+}

@@ -1,0 +1,414 @@
+//! The JavaScript API for measured data (issue 7): reading a recording, its spectrum, the
+//! identified modes and the recommended shaper. Thin glue over [`crate::measure`]; long arrays
+//! cross the boundary as `Float64Array`s (copying 10⁶ numbers into a typed array is far cheaper
+//! than building a JS array). Errors are JS `Error`s with `kind` and `field` as in `wasm.rs`;
+//! recording errors also carry `line` and `column` (1-based) and `columnName`.
+
+use crate::canvas::Canvas;
+use crate::chart::{self, ChartStyle};
+use crate::error::Error;
+use crate::measure::identify::{identify, IdentifyOptions};
+use crate::measure::psd::{fft_spectrum, welch, FftOptions, Psd, WelchOptions};
+use crate::measure::recommend::{recommend, MeasuredMode, MeasuredSpectrum, RecommendOptions};
+use crate::measure::recording::{self, Recording, RecordingError, RecordingOptions};
+use crate::wasm::{from_js, js_error, set, to_js};
+use plotters::prelude::*;
+use serde::Deserialize;
+use wasm_bindgen::prelude::*;
+use wasm_bindgen::JsCast;
+use web_sys::HtmlCanvasElement;
+
+/// A recording error as a JS `Error` with `line`, `column`, `columnName`.
+fn recording_error(e: RecordingError) -> JsValue {
+    let (line, column, name) = (e.line, e.column, e.column_name.clone());
+    let js = js_error(Error::from(e));
+    if let Some(obj) = js.dyn_ref::<js_sys::Object>() {
+        let _ = js_sys::Reflect::set(obj, &"line".into(), &(line as f64).into());
+        if let Some(c) = column {
+            let _ = js_sys::Reflect::set(obj, &"column".into(), &(c as f64).into());
+        }
+        if let Some(n) = name {
+            let _ = js_sys::Reflect::set(obj, &"columnName".into(), &n.into());
+        }
+    }
+    js
+}
+
+/// Options object, `{}` when missing.
+fn options<T: serde::de::DeserializeOwned + Default>(
+    value: JsValue,
+    what: &str,
+) -> Result<T, Error> {
+    if value.is_undefined() || value.is_null() {
+        Ok(T::default())
+    } else {
+        from_js(value, what)
+    }
+}
+
+/// A `Float64Array` or an array of numbers as a `Vec<f64>`, naming `field[i]` otherwise.
+fn f64_vec(value: &JsValue, field: &str) -> Result<Vec<f64>, Error> {
+    if let Some(a) = value.dyn_ref::<js_sys::Float64Array>() {
+        return Ok(a.to_vec());
+    }
+    if let Some(a) = value.dyn_ref::<js_sys::Float32Array>() {
+        return Ok(a.to_vec().into_iter().map(f64::from).collect());
+    }
+    if let Some(a) = value.dyn_ref::<js_sys::Array>() {
+        return a
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                v.as_f64().ok_or_else(|| Error::Parse {
+                    field: format!("{field}[{i}]"),
+                    reason: "must be a number".into(),
+                })
+            })
+            .collect();
+    }
+    Err(Error::Parse {
+        field: field.to_string(),
+        reason: if value.is_undefined() || value.is_null() {
+            "is missing".into()
+        } else {
+            "must be a Float64Array or an array of numbers".into()
+        },
+    })
+}
+
+fn get(object: &JsValue, key: &str) -> JsValue {
+    js_sys::Reflect::get(object, &key.into()).unwrap_or(JsValue::UNDEFINED)
+}
+
+fn recording_to_js(rec: &Recording) -> Result<JsValue, JsValue> {
+    let out = js_sys::Object::new();
+    set(&out, "format", &to_js(&rec.format)?)?;
+    set(&out, "timeColumn", &rec.time_column.clone().into())?;
+    set(&out, "sampleRateHz", &rec.sample_rate_hz.into())?;
+    set(&out, "startTimeS", &rec.start_time_s.into())?;
+    set(&out, "durationS", &rec.duration_s.into())?;
+    set(&out, "rows", &(rec.rows as f64).into())?;
+    set(&out, "resampled", &rec.resampled.into())?;
+    set(&out, "timing", &to_js(&rec.timing)?)?;
+    let channels = js_sys::Array::new();
+    for c in &rec.channels {
+        let ch = js_sys::Object::new();
+        set(&ch, "name", &c.name.clone().into())?;
+        set(
+            &ch,
+            "values",
+            &js_sys::Float64Array::from(c.values.as_slice()),
+        )?;
+        channels.push(&ch);
+    }
+    set(&out, "channels", &channels)?;
+    Ok(out.into())
+}
+
+fn psd_to_js(psd: &Psd) -> Result<JsValue, JsValue> {
+    let out = js_sys::Object::new();
+    set(
+        &out,
+        "frequencyHz",
+        &js_sys::Float64Array::from(psd.frequency_hz.as_slice()),
+    )?;
+    set(&out, "psd", &js_sys::Float64Array::from(psd.psd.as_slice()))?;
+    set(&out, "segmentLength", &(psd.segment_length as f64).into())?;
+    set(&out, "overlap", &(psd.overlap as f64).into())?;
+    set(&out, "segments", &(psd.segments as f64).into())?;
+    set(&out, "resolutionHz", &psd.resolution_hz.into())?;
+    set(&out, "enbwBins", &psd.enbw_bins.into())?;
+    set(&out, "sampleRateHz", &psd.sample_rate_hz.into())?;
+    Ok(out.into())
+}
+
+/// `parseRecording(text, { timeColumn?, timeScale? })` → `{ format: 'klipper' | 'csv',
+/// timeColumn, sampleRateHz, startTimeS, durationS, rows, resampled, timing: { meanStepS,
+/// minStepS, maxStepS, jitter }, channels: [{ name, values: Float64Array }] }`. Errors carry
+/// `line`, `column`, `columnName`.
+#[wasm_bindgen(js_name = parseRecording)]
+pub fn parse_recording(text: &str, options: JsValue) -> Result<JsValue, JsValue> {
+    let options: RecordingOptions = self::options(options, "options").map_err(js_error)?;
+    let rec = recording::parse_recording(text, &options).map_err(recording_error)?;
+    recording_to_js(&rec)
+}
+
+/// `new RecordingParser({ timeColumn?, timeScale? })`: reads a recording in chunks —
+/// `push(text)` any number of times (lines may span chunks), then `finish()` → the same object
+/// as `parseRecording`. `lines` and `rows` say how far it got (for a progress bar).
+#[wasm_bindgen(js_name = RecordingParser)]
+pub struct JsRecordingParser {
+    inner: Option<recording::RecordingParser>,
+}
+
+#[wasm_bindgen(js_class = RecordingParser)]
+impl JsRecordingParser {
+    /// A parser with the options of `parseRecording`.
+    #[wasm_bindgen(constructor)]
+    pub fn new(options: JsValue) -> Result<JsRecordingParser, JsValue> {
+        let options: RecordingOptions = self::options(options, "options").map_err(js_error)?;
+        Ok(JsRecordingParser {
+            inner: Some(recording::RecordingParser::new(options)),
+        })
+    }
+
+    /// Reads a chunk of text; throws at the first bad line (and on every later call).
+    pub fn push(&mut self, chunk: &str) -> Result<(), JsValue> {
+        match &mut self.inner {
+            Some(p) => p.push(chunk).map_err(recording_error),
+            None => Err(js_error(Error::invalid(
+                "recording",
+                "finish() was already called",
+            ))),
+        }
+    }
+
+    /// Lines read so far.
+    #[wasm_bindgen(getter)]
+    pub fn lines(&self) -> f64 {
+        self.inner.as_ref().map_or(0.0, |p| p.lines() as f64)
+    }
+
+    /// Data rows read so far.
+    #[wasm_bindgen(getter)]
+    pub fn rows(&self) -> f64 {
+        self.inner.as_ref().map_or(0.0, |p| p.rows() as f64)
+    }
+
+    /// Ends the input and returns the recording (see `parseRecording`).
+    pub fn finish(&mut self) -> Result<JsValue, JsValue> {
+        let p = self
+            .inner
+            .take()
+            .ok_or_else(|| js_error(Error::invalid("recording", "finish() was already called")))?;
+        let rec = p.finish().map_err(recording_error)?;
+        recording_to_js(&rec)
+    }
+}
+
+/// `welch(signal, { sampleRateHz, segmentLength?, overlap?, window?, kaiserBeta?,
+/// symmetricWindow?, detrend?, scaling? })` → `{ frequencyHz, psd (Float64Array),
+/// segmentLength, overlap, segments, resolutionHz, enbwBins, sampleRateHz }`; `signal` is a
+/// `Float64Array` or an array of numbers. `{ preset: 'klipper', sampleRateHz }` takes
+/// Klipper's settings instead.
+#[wasm_bindgen(js_name = welch)]
+pub fn welch_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+    let x = f64_vec(&signal, "signal").map_err(js_error)?;
+    let preset = get(&options, "preset").as_string();
+    let opts: WelchOptions = if preset.as_deref() == Some("klipper") {
+        let fs = get(&options, "sampleRateHz").as_f64().unwrap_or(f64::NAN);
+        WelchOptions::klipper(fs)
+    } else {
+        from_js(options, "options").map_err(js_error)?
+    };
+    let psd = welch(&x, &opts).map_err(js_error)?;
+    psd_to_js(&psd)
+}
+
+/// `fftSpectrum(signal, { sampleRateHz, window?, kaiserBeta?, detrend? })` → `{ frequencyHz,
+/// magnitude (Float64Array), resolutionHz }`: the amplitude spectrum of the whole record.
+#[wasm_bindgen(js_name = fftSpectrum)]
+pub fn fft_spectrum_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+    let x = f64_vec(&signal, "signal").map_err(js_error)?;
+    let opts: FftOptions = from_js(options, "options").map_err(js_error)?;
+    let s = fft_spectrum(&x, &opts).map_err(js_error)?;
+    let out = js_sys::Object::new();
+    set(
+        &out,
+        "frequencyHz",
+        &js_sys::Float64Array::from(s.frequency_hz.as_slice()),
+    )?;
+    set(
+        &out,
+        "magnitude",
+        &js_sys::Float64Array::from(s.magnitude.as_slice()),
+    )?;
+    set(&out, "resolutionHz", &s.resolution_hz.into())?;
+    Ok(out.into())
+}
+
+#[derive(Deserialize, Default)]
+#[serde(rename_all = "camelCase", default)]
+struct ChannelChoice {
+    channel: Option<serde_json_like::ChannelKey>,
+}
+
+mod serde_json_like {
+    use serde::Deserialize;
+    /// A channel by name or index.
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    pub(super) enum ChannelKey {
+        Index(usize),
+        Name(String),
+    }
+}
+
+/// `identifyModes(recording, options)`: `recording` is what `parseRecording` returns (then
+/// `options.channel` picks a channel by name or index, default the first) or a plain signal
+/// (`Float64Array` / number array, then `options.sampleRateHz` is required). Options as
+/// `IdentifyOptions`: `{ sampleRateHz?, signal: 'acceleration' | 'velocity' | 'position',
+/// maxModes, minFrequencyHz, maxFrequencyHz, minProminenceDb, segmentLength, freeDecay }`.
+/// → `{ channel, modes: [{ frequencyHz, damping, frequencyUncertaintyHz, dampingUncertainty,
+/// method, peakFrequencyHz, peakPsd, prominenceDb, estimates: [...] }], spectrum: { frequencyHz,
+/// psd, … }, detectionSegmentLength, bandHz, freeDecay: { startS, endS, levelDb } | null }`.
+#[wasm_bindgen(js_name = identifyModes)]
+pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+    let is_signal = recording.is_instance_of::<js_sys::Float64Array>()
+        || recording.is_instance_of::<js_sys::Float32Array>()
+        || js_sys::Array::is_array(&recording);
+    let choice: ChannelChoice = if options.is_object() {
+        from_js(options.clone(), "options").map_err(js_error)?
+    } else {
+        ChannelChoice::default()
+    };
+    let mut opts: IdentifyOptions = {
+        // `channel` is not an IdentifyOptions field: read the others from a copy without it.
+        let copy = js_sys::Object::new();
+        if options.is_object() {
+            let _ = js_sys::Object::assign(&copy, options.unchecked_ref());
+            let _ = js_sys::Reflect::delete_property(&copy, &"channel".into());
+        }
+        from_js(copy.into(), "options").map_err(js_error)?
+    };
+    let (signal, name) = if is_signal {
+        (
+            f64_vec(&recording, "signal").map_err(js_error)?,
+            JsValue::NULL,
+        )
+    } else {
+        let channels = get(&recording, "channels");
+        let channels: js_sys::Array = channels.dyn_into().map_err(|_| {
+            js_error(Error::Parse {
+                field: "recording.channels".into(),
+                reason: "is missing: pass what parseRecording returns, or a signal".into(),
+            })
+        })?;
+        let index = match &choice.channel {
+            None => 0,
+            Some(serde_json_like::ChannelKey::Index(i)) => *i,
+            Some(serde_json_like::ChannelKey::Name(n)) => channels
+                .iter()
+                .position(|c| get(&c, "name").as_string().as_deref() == Some(n.as_str()))
+                .ok_or_else(|| {
+                    js_error(Error::invalid(
+                        "options.channel",
+                        format!("no channel named `{n}`"),
+                    ))
+                })?,
+        };
+        if index >= channels.length() as usize {
+            return Err(js_error(Error::invalid(
+                "options.channel",
+                format!("the recording has {} channels", channels.length()),
+            )));
+        }
+        let c = channels.get(index as u32);
+        if opts.sample_rate_hz.is_nan() {
+            opts.sample_rate_hz = get(&recording, "sampleRateHz").as_f64().unwrap_or(f64::NAN);
+        }
+        (
+            f64_vec(
+                &get(&c, "values"),
+                &format!("recording.channels[{index}].values"),
+            )
+            .map_err(js_error)?,
+            get(&c, "name"),
+        )
+    };
+    let id = identify(&signal, &opts).map_err(js_error)?;
+    let out = js_sys::Object::new();
+    set(&out, "channel", &name)?;
+    set(&out, "modes", &to_js(&id.modes)?)?;
+    set(&out, "spectrum", &psd_to_js(&id.spectrum)?)?;
+    set(
+        &out,
+        "detectionSegmentLength",
+        &(id.detection_segment_length as f64).into(),
+    )?;
+    set(&out, "bandHz", &to_js(&id.band_hz)?)?;
+    set(&out, "freeDecay", &to_js(&id.free_decay)?)?;
+    Ok(out.into())
+}
+
+/// `recommendShaper(spectrum, modes, options?)`: `spectrum = { frequencyHz, psd }` (arrays or
+/// `Float64Array`s, e.g. `identifyModes(…).spectrum`), `modes = [{ frequencyHz, damping,
+/// frequencyUncertaintyHz?, dampingUncertainty? }]` (e.g. `identifyModes(…).modes`), options
+/// `{ families?: [{ family, … }], criterion?: 'duration' | 'klipper', maxRemainingVibration?,
+/// scv?, uncertaintySigmas?, minFrequencyHz?, maxFrequencyHz? }` → `{ criterion, recommended,
+/// ranked: [{ label, family, spec, modes, shaper, durationS, remainingVibration,
+/// nominalRemainingVibration, smoothing, maxAccel, klipperScore, acceptable }], dampingTested,
+/// frequencyFactors, bandHz }`.
+#[wasm_bindgen(js_name = recommendShaper)]
+pub fn recommend_shaper(
+    spectrum: JsValue,
+    modes: JsValue,
+    options: JsValue,
+) -> Result<JsValue, JsValue> {
+    let spectrum = MeasuredSpectrum {
+        frequency_hz: f64_vec(&get(&spectrum, "frequencyHz"), "spectrum.frequencyHz")
+            .map_err(js_error)?,
+        psd: f64_vec(&get(&spectrum, "psd"), "spectrum.psd").map_err(js_error)?,
+    };
+    let modes: Vec<MeasuredMode> = from_js(modes, "modes").map_err(js_error)?;
+    let options: RecommendOptions = self::options(options, "options").map_err(js_error)?;
+    let r = recommend(&spectrum, &modes, &options).map_err(js_error)?;
+    to_js(&r)
+}
+
+#[derive(Deserialize, Default)]
+#[serde(rename_all = "camelCase", default)]
+struct DrawOptions {
+    peaks_hz: Vec<f64>,
+    max_hz: Option<f64>,
+    pixel_ratio: Option<f64>,
+    title: Option<String>,
+    y_label: Option<String>,
+}
+
+/// `drawSpectrum(canvas, spectrum, { peaksHz?, maxHz?, pixelRatio?, title?, yLabel? })`: draws
+/// `spectrum = { frequencyHz, psd }` in dB (10·log₁₀ psd) on the canvas with a labelled marker
+/// at each of `peaksHz`; `title` / `yLabel` default to "Measured spectrum (Welch PSD)" /
+/// "PSD (dB)" (pass |X|² as `psd` to draw an FFT magnitude in dB).
+#[wasm_bindgen(js_name = drawSpectrum)]
+pub fn draw_spectrum(
+    canvas: HtmlCanvasElement,
+    spectrum: JsValue,
+    options: JsValue,
+) -> Result<(), JsValue> {
+    let f = f64_vec(&get(&spectrum, "frequencyHz"), "spectrum.frequencyHz").map_err(js_error)?;
+    let p = f64_vec(&get(&spectrum, "psd"), "spectrum.psd").map_err(js_error)?;
+    let o: DrawOptions = self::options(options, "options").map_err(js_error)?;
+    let peaks: Vec<(f64, String)> = o
+        .peaks_hz
+        .iter()
+        .map(|&f| (f, format!("{f:.2} Hz")))
+        .collect();
+    let style = ChartStyle {
+        scale: o
+            .pixel_ratio
+            .filter(|r| r.is_finite() && *r > 0.0)
+            .unwrap_or(1.0),
+    };
+    let backend = Canvas::new(canvas).ok_or_else(|| {
+        js_error(Error::Render {
+            reason: "the canvas has no 2D context".into(),
+        })
+    })?;
+    let titles = (
+        o.title.as_deref().unwrap_or(chart::measured::PSD_TITLES.0),
+        o.y_label
+            .as_deref()
+            .unwrap_or(chart::measured::PSD_TITLES.1),
+    );
+    chart::draw_measured_spectrum(
+        &backend.into_drawing_area(),
+        &f,
+        &p,
+        &peaks,
+        o.max_hz,
+        titles,
+        &style,
+    )
+    .map_err(js_error)
+}

@@ -1,0 +1,63 @@
+// The measured-data worker: reads a recording in chunks, identifies the modes and ranks the
+// shapers off the page's thread, so a 10⁶-row file never freezes the page. Messages in:
+// { id, type: 'load', file, options }, { id, type: 'analyse', options } and { id, type: 'fft',
+// channel }; out: progress, result ({ recording, identification, recommendation }), fft
+// ({ spectrum }) or error ({ message, line, column }).
+import init, { RecordingParser, identifyModes, recommendShaper, fftSpectrum } from '../pkg/input_shaping.js';
+
+const CHUNK_BYTES = 1 << 20;
+const ready = init();
+let recording = null; // the last good recording
+
+function summary(r) {
+  const { channels, ...rest } = r;
+  return { ...rest, channels: channels.map((c) => c.name) };
+}
+
+async function read(id, file) {
+  const parser = new RecordingParser({});
+  const decoder = new TextDecoder('utf-8');
+  try {
+    for (let offset = 0; offset < file.size; offset += CHUNK_BYTES) {
+      const bytes = await file.slice(offset, offset + CHUNK_BYTES).arrayBuffer();
+      parser.push(decoder.decode(bytes, { stream: true }));
+      postMessage({ id, type: 'progress', fraction: Math.min(1, (offset + bytes.byteLength) / Math.max(1, file.size)), rows: parser.rows });
+    }
+    parser.push(decoder.decode());
+    return parser.finish();
+  } finally {
+    parser.free();
+  }
+}
+
+function analyse(id, rec, options) {
+  postMessage({ id, type: 'analysing', rows: rec.rows });
+  const identification = identifyModes(rec, options);
+  const recommendation = identification.modes.length > 0
+    ? recommendShaper(identification.spectrum, identification.modes, {})
+    : null;
+  return { id, type: 'result', recording: summary(rec), identification, recommendation };
+}
+
+onmessage = async ({ data }) => {
+  const { id } = data;
+  try {
+    await ready;
+    if (data.type === 'load') {
+      const rec = await read(id, data.file);
+      const result = analyse(id, rec, data.options);
+      recording = rec; // only once everything worked: a bad file leaves the last good one
+      postMessage(result);
+    } else if (data.type === 'analyse' && recording) {
+      postMessage(analyse(id, recording, data.options));
+    } else if (data.type === 'fft' && recording) {
+      // The plain FFT magnitude of the whole channel (at most 2^22 samples), as |X|² for the chart.
+      const values = recording.channels[data.channel]?.values ?? recording.channels[0].values;
+      const s = fftSpectrum(values, { sampleRateHz: recording.sampleRateHz });
+      const power = s.magnitude.map((m) => m * m);
+      postMessage({ id, type: 'fft', spectrum: { frequencyHz: s.frequencyHz, psd: power } }, [power.buffer]);
+    }
+  } catch (e) {
+    postMessage({ id, type: 'error', message: e?.message ?? String(e), line: e?.line, column: e?.column });
+  }
+};
