@@ -297,8 +297,30 @@ fn check_frequency(field: &str, f: f64) -> Result<()> {
     Ok(())
 }
 
+/// Most zero-vibration constraints (modes) a problem may have.
+pub const MAX_ZEROS: usize = crate::mode::MAX_MODES;
+/// Most zero derivatives per mode (each adds two equality rows per derivative).
+pub const MAX_ZERO_DERIVATIVES: u32 = crate::design::direct::MAX_DIRECT_DERIVATIVES;
+/// Most sampled limits (200 frequencies at up to 64 damping ratios).
+pub const MAX_LIMITS: usize = 200 * crate::mode::MAX_MODES;
+/// Most bands.
+pub const MAX_BANDS: usize = crate::mode::MAX_MODES;
+
 impl NormalizedProblem {
     fn new(p: &Problem) -> Result<Self> {
+        // Sizes first, so nothing below (or in the programs) grows without bound.
+        crate::error::count("modes", p.zeros.len(), 0, MAX_ZEROS)?;
+        crate::error::count("sampleFrequenciesHz", p.limits.len(), 0, MAX_LIMITS)?;
+        crate::error::count("bands", p.bands.len(), 0, MAX_BANDS)?;
+        for z in &p.zeros {
+            if z.derivatives > MAX_ZERO_DERIVATIVES {
+                return Err(Error::TooLarge {
+                    field: "derivatives".into(),
+                    value: f64::from(z.derivatives),
+                    limit: f64::from(MAX_ZERO_DERIVATIVES),
+                });
+            }
+        }
         finite("amplitudeMin", p.amplitude_min)?;
         finite("amplitudeMax", p.amplitude_max)?;
         if p.amplitude_max <= 0.0 || p.amplitude_min >= p.amplitude_max || p.amplitude_min > 1.0 {
