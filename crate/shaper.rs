@@ -115,7 +115,7 @@ impl Shaper {
         // normalisation produced them): refuse rather than return an infinite impulse.
         if let Some(k) = merged
             .iter()
-            .position(|imp| !(imp.amplitude.abs() <= MAX_AMPLITUDE))
+            .position(|imp| imp.amplitude.is_nan() || imp.amplitude.abs() > MAX_AMPLITUDE)
         {
             return Err(Error::invalid(
                 format!("impulses[{k}].amplitude"),
