@@ -49,6 +49,9 @@ layer fmt cargo fmt --check
 layer clippy cargo clippy --all-targets -- -D warnings
 layer clippy-wasm cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
 layer native cargo test
+# Reliability (issue 6): property tests, the fuzz target's function on stable, the quick
+# convergence grid. Every loop in the library is bounded; the timeout turns a hang into a failure.
+layer reliability timeout 1500 bash -c 'cargo test --test prop_design --test prop_analysis --test fuzz_replay && cargo test --test convergence -- --nocapture'
 layer wasm-node wasm-pack test --node
 layer wasm-browser wasm-pack test --headless --chrome
 layer build bash scripts/build.sh
