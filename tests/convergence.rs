@@ -140,8 +140,7 @@ fn amplitudes_in(imps: &[(f64, f64)], lo: f64, hi: f64) -> Result<(), String> {
 fn scan_points(lo: f64, hi: f64, t_n: f64) -> usize {
     (60.0 * (hi - lo) * t_n.max(1e-9))
         .ceil()
-        .max(4000.0)
-        .min(400_000.0) as usize
+        .clamp(4000.0, 400_000.0) as usize
 }
 
 /// SI whole-band promise: V ≤ vtol on every band at every damping in `dampings`.
