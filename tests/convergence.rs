@@ -39,9 +39,12 @@ struct Tally {
     reasons: BTreeMap<String, usize>,
 }
 
-#[derive(Default)]
 struct Grid {
     families: BTreeMap<&'static str, Tally>,
+    /// When the previous point was recorded (each point's design + check time is printed).
+    last: std::time::Instant,
+    /// Which families to run.
+    only: Vec<&'static str>,
 }
 
 impl Grid {
@@ -53,6 +56,12 @@ impl Grid {
         result: Result<Shaper, Error>,
         check: impl FnOnce(&Shaper) -> Result<(), String>,
     ) {
+        let seconds = self.last.elapsed().as_secs_f64();
+        let outcome = match &result {
+            Ok(_) => "ok",
+            Err(_) => "error",
+        };
+        eprintln!("  [{seconds:6.2} s] {what}: {outcome}");
         let tally = self.families.entry(family).or_default();
         match result {
             Ok(shaper) => match check_valid(&shaper).and_then(|_| check(&shaper)) {
@@ -82,6 +91,11 @@ impl Grid {
                 *tally.reasons.entry(format!("{kind}: {short}")).or_default() += 1;
             }
         }
+        self.last = std::time::Instant::now();
+    }
+
+    fn wants(&self, family: &str) -> bool {
+        self.only.contains(&family)
     }
 
     fn report_and_assert(&self) {
@@ -128,7 +142,8 @@ fn amplitudes_in(imps: &[(f64, f64)], lo: f64, hi: f64) -> Result<(), String> {
         return Err(format!("Σ A = {sum}"));
     }
     for p in imps {
-        if p.1 < lo - 1e-9 || p.1 > hi + 1e-9 {
+        // The library's bound slack: 1e-8 of the bounds' range (solver tolerance).
+        if p.1 < lo - 1e-8 * (hi - lo) || p.1 > hi + 1e-8 * (hi - lo) {
             return Err(format!("amplitude {} outside [{lo}, {hi}]", p.1));
         }
     }
@@ -294,226 +309,144 @@ struct Axes {
     damping_halfwidths: Vec<f64>,
 }
 
-fn run(axes: &Axes) {
-    let mut grid = Grid::default();
+fn run(axes: &Axes, only: &[&'static str]) {
+    let mut grid = Grid {
+        families: BTreeMap::new(),
+        last: std::time::Instant::now(),
+        only: only.to_vec(),
+    };
     let f0 = 1.0;
 
     // SI, one mode: ζ × I × Vtol, whole band at the mode's damping.
-    for &z in &axes.zetas {
-        for &i in &axes.insens {
-            for &vtol in &axes.vtols {
-                let spec = SiSpec {
-                    vtol,
-                    insensitivity: Some(i),
-                    ..SiSpec::default()
-                };
-                let what = format!("si f=1 ζ={z} I={i} Vtol={vtol}");
-                let band = [(f0 * (1.0 - i / 2.0), f0 * (1.0 + i / 2.0))];
-                grid.point("si", what, design(&spec.request(modes_of(&[f0], z))), |s| {
-                    check_si(s, &band, &[z], vtol)
-                });
+    if grid.wants("si") {
+        for &z in &axes.zetas {
+            for &i in &axes.insens {
+                for &vtol in &axes.vtols {
+                    let spec = SiSpec {
+                        vtol,
+                        insensitivity: Some(i),
+                        ..SiSpec::default()
+                    };
+                    let what = format!("si f=1 ζ={z} I={i} Vtol={vtol}");
+                    let band = [(f0 * (1.0 - i / 2.0), f0 * (1.0 + i / 2.0))];
+                    grid.point("si", what, design(&spec.request(modes_of(&[f0], z))), |s| {
+                        check_si(s, &band, &[z], vtol)
+                    });
+                }
             }
         }
     }
 
     // SI over a damping range [ζ − w, ζ + w] ∩ [0, 0.3].
-    for &z in &axes.zetas {
-        for &w in &axes.damping_halfwidths {
-            for &i in axes.insens.iter().step_by(2) {
-                for &vtol in &axes.vtols {
-                    let (lo, hi) = ((z - w).max(0.0), (z + w).min(0.3));
-                    let spec = SiSpec {
-                        vtol,
-                        insensitivity: Some(i),
-                        damping_range: Some([lo, hi]),
-                        ..SiSpec::default()
-                    };
-                    let what = format!("si ζ∈[{lo},{hi}] I={i} Vtol={vtol}");
-                    let band = [(f0 * (1.0 - i / 2.0), f0 * (1.0 + i / 2.0))];
-                    grid.point(
-                        "si-damping",
-                        what,
-                        design(&spec.request(modes_of(&[f0], z))),
-                        |s| check_si(s, &band, &damping_levels(lo, hi), vtol),
-                    );
+    if grid.wants("si-damping") {
+        for &z in &axes.zetas {
+            for &w in &axes.damping_halfwidths {
+                for &i in axes.insens.iter().step_by(2) {
+                    for &vtol in &axes.vtols {
+                        let (lo, hi) = ((z - w).max(0.0), (z + w).min(0.3));
+                        let spec = SiSpec {
+                            vtol,
+                            insensitivity: Some(i),
+                            damping_range: Some([lo, hi]),
+                            ..SiSpec::default()
+                        };
+                        let what = format!("si ζ∈[{lo},{hi}] I={i} Vtol={vtol}");
+                        let band = [(f0 * (1.0 - i / 2.0), f0 * (1.0 + i / 2.0))];
+                        grid.point(
+                            "si-damping",
+                            what,
+                            design(&spec.request(modes_of(&[f0], z))),
+                            |s| check_si(s, &band, &damping_levels(lo, hi), vtol),
+                        );
+                    }
                 }
             }
         }
     }
 
     // SI, several modes: a band of insensitivity I around each.
-    for set in axes.mode_sets.iter().filter(|s| s.len() > 1) {
-        for &z in axes.zetas.iter().step_by(2) {
-            for &i in axes.insens.iter().step_by(2) {
-                let vtol = 0.05;
-                let spec = SiSpec {
-                    vtol,
-                    insensitivity: Some(i),
-                    ..SiSpec::default()
-                };
-                let what = format!("si modes={set:?} ζ={z} I={i}");
-                let bands: Vec<(f64, f64)> = set
-                    .iter()
-                    .map(|&f| (f * (1.0 - i / 2.0), f * (1.0 + i / 2.0)))
-                    .collect();
-                grid.point(
-                    "si-modes",
-                    what,
-                    design(&spec.request(modes_of(set, z))),
-                    |s| check_si(s, &bands, &[z], vtol),
-                );
+    if grid.wants("si-modes") {
+        for set in axes.mode_sets.iter().filter(|s| s.len() > 1) {
+            for &z in axes.zetas.iter().step_by(2) {
+                for &i in axes.insens.iter().step_by(2) {
+                    let vtol = 0.05;
+                    let spec = SiSpec {
+                        vtol,
+                        insensitivity: Some(i),
+                        ..SiSpec::default()
+                    };
+                    let what = format!("si modes={set:?} ζ={z} I={i}");
+                    let bands: Vec<(f64, f64)> = set
+                        .iter()
+                        .map(|&f| (f * (1.0 - i / 2.0), f * (1.0 + i / 2.0)))
+                        .collect();
+                    grid.point(
+                        "si-modes",
+                        what,
+                        design(&spec.request(modes_of(set, z))),
+                        |s| check_si(s, &bands, &[z], vtol),
+                    );
+                }
             }
         }
     }
 
     // EI and n-hump EI with damping, one mode.
-    for &n in &axes.humps {
-        for &z in &axes.zetas {
-            for &vtol in &axes.vtols {
-                let request = DesignRequest {
-                    modes: modes_of(&[f0], z),
-                    shaper: ShaperSpec::Eihump { humps: n, vtol },
-                };
-                let what = format!("eihump n={n} ζ={z} Vtol={vtol}");
-                grid.point("ei", what, design(&request), |s| {
-                    check_ei(s, f0, z, n, vtol)
-                });
+    if grid.wants("ei") {
+        for &n in &axes.humps {
+            for &z in &axes.zetas {
+                for &vtol in &axes.vtols {
+                    let request = DesignRequest {
+                        modes: modes_of(&[f0], z),
+                        shaper: ShaperSpec::Eihump { humps: n, vtol },
+                    };
+                    let what = format!("eihump n={n} ζ={z} Vtol={vtol}");
+                    grid.point("ei", what, design(&request), |s| {
+                        check_ei(s, f0, z, n, vtol)
+                    });
+                }
             }
         }
     }
 
     // EI for several modes (convolved): every factor keeps its promise and the result is their
     // convolution (V is the product of the factors' V).
-    for set in axes.mode_sets.iter().filter(|s| s.len() > 1) {
-        for &n in axes.humps.iter().take(2) {
-            for &z in axes.zetas.iter().step_by(2) {
-                let vtol = 0.05;
-                let request = DesignRequest {
-                    modes: modes_of(set, z),
-                    shaper: ShaperSpec::Eihump { humps: n, vtol },
-                };
-                let what = format!("eihump n={n} modes={set:?} ζ={z}");
-                let factors: Vec<Result<Shaper, Error>> = set
-                    .iter()
-                    .map(|&f| {
-                        design(&DesignRequest {
-                            modes: modes_of(&[f], z),
-                            shaper: ShaperSpec::Eihump { humps: n, vtol },
-                        })
-                    })
-                    .collect();
-                grid.point("ei-modes", what, design(&request), |s| {
-                    let imps = pairs(s);
-                    let mut fs = Vec::new();
-                    for (k, r) in factors.iter().enumerate() {
-                        let f = r.as_ref().map_err(|e| format!("factor {k} failed: {e}"))?;
-                        check_ei(f, set[k], z, n, vtol).map_err(|e| format!("factor {k}: {e}"))?;
-                        fs.push(pairs(f));
-                    }
-                    let top = set.iter().fold(0.0_f64, |a, &b| a.max(b)) * 3.0;
-                    for j in 1..=3000 {
-                        let f = top * j as f64 / 3000.0;
-                        let product: f64 = fs.iter().map(|p| v_eq11(p, f, z)).product();
-                        let got = v_eq11(&imps, f, z);
-                        if (got - product).abs() > 1e-9 * (1.0 + product) {
-                            return Err(format!(
-                                "V = {got} at {f} Hz, product of factors {product}"
-                            ));
-                        }
-                    }
-                    Ok(())
-                });
-            }
-        }
-    }
-
-    // Direct multi-mode: V and n derivatives zero at every mode; no longer than the convolved
-    // ZV-Dⁿ (a feasible point of the same program, so the shortest cannot exceed it).
-    for set in &axes.mode_sets {
-        for &z in &axes.zetas {
-            for &d in &axes.direct_derivatives {
-                let spec = DirectSpec {
-                    derivatives: d,
-                    ..DirectSpec::default()
-                };
-                let what = format!("direct n={d} modes={set:?} ζ={z}");
-                let points: Vec<(f64, f64)> = set.iter().map(|&f| (f, z)).collect();
-                let convolved: Option<f64> = set
-                    .iter()
-                    .map(|&f| Mode::new(f, z).and_then(|m| zero_vibration::zv_dn(&m, d)))
-                    .try_fold(Shaper::identity(), |acc, s| acc.convolve(&s?))
-                    .ok()
-                    .map(|s| s.duration());
-                grid.point(
-                    "direct",
-                    what,
-                    design(&spec.request(modes_of(set, z))),
-                    |s| {
-                        amplitudes_in(&pairs(s), 0.0, 1.0)?;
-                        check_zero_derivatives(s, &points, d)?;
-                        if let Some(c) = convolved {
-                            if s.duration() > c * 1.01 {
-                                return Err(format!(
-                                    "duration {} s longer than the convolved shaper's {c} s",
-                                    s.duration()
-                                ));
-                            }
-                        }
-                        Ok(())
-                    },
-                );
-            }
-        }
-    }
-
-    // Sampled (Kamel et al.): impulses on t = iT, Σ A = 1, V and derivatives zero at the mode,
-    // and the prescribed ramp delay τ = 2ζ/ω + Σ Aᵢtᵢ = mT when asked.
-    for &z in &axes.zetas {
-        for &(wt, n) in &axes.sampled {
-            for d in 0..=2u32 {
-                for delay in [None, Some(n as u32 / 2)] {
-                    let f = 1.0;
-                    let period = wt / (2.0 * PI * f);
-                    let spec = SampledSpec {
-                        derivatives: d,
-                        delay_samples: delay,
-                        ..SampledSpec::new(period, n)
-                    };
+    if grid.wants("ei-modes") {
+        for set in axes.mode_sets.iter().filter(|s| s.len() > 1) {
+            for &n in axes.humps.iter().take(2) {
+                for &z in axes.zetas.iter().step_by(2) {
+                    let vtol = 0.05;
                     let request = DesignRequest {
-                        modes: modes_of(&[f], z),
-                        shaper: ShaperSpec::Sampled(spec.clone()),
+                        modes: modes_of(set, z),
+                        shaper: ShaperSpec::Eihump { humps: n, vtol },
                     };
-                    let what = format!("sampled ωT={wt} n={n} d={d} m={delay:?} ζ={z}");
-                    let start = Mode::new(f, z)
-                        .and_then(|m| sampled::report(&[m], &spec))
-                        .map(|r| r.start_time);
-                    grid.point("sampled", what, design(&request), |s| {
+                    let what = format!("eihump n={n} modes={set:?} ζ={z}");
+                    let factors: Vec<Result<Shaper, Error>> = set
+                        .iter()
+                        .map(|&f| {
+                            design(&DesignRequest {
+                                modes: modes_of(&[f], z),
+                                shaper: ShaperSpec::Eihump { humps: n, vtol },
+                            })
+                        })
+                        .collect();
+                    grid.point("ei-modes", what, design(&request), |s| {
                         let imps = pairs(s);
-                        let sum: f64 = imps.iter().map(|p| p.1).sum();
-                        if (sum - 1.0).abs() > 1e-9 {
-                            return Err(format!("Σ A = {sum}"));
+                        let mut fs = Vec::new();
+                        for (k, r) in factors.iter().enumerate() {
+                            let f = r.as_ref().map_err(|e| format!("factor {k} failed: {e}"))?;
+                            check_ei(f, set[k], z, n, vtol)
+                                .map_err(|e| format!("factor {k}: {e}"))?;
+                            fs.push(pairs(f));
                         }
-                        for p in &imps {
-                            let k = p.0 / period;
-                            if (k - k.round()).abs() > 1e-6 {
+                        let top = set.iter().fold(0.0_f64, |a, &b| a.max(b)) * 3.0;
+                        for j in 1..=3000 {
+                            let f = top * j as f64 / 3000.0;
+                            let product: f64 = fs.iter().map(|p| v_eq11(p, f, z)).product();
+                            let got = v_eq11(&imps, f, z);
+                            if (got - product).abs() > 1e-9 * (1.0 + product) {
                                 return Err(format!(
-                                    "impulse at {} s is not on the period grid",
-                                    p.0
-                                ));
-                            }
-                        }
-                        if imps.len() > n {
-                            return Err(format!("{} impulses, more than {n}", imps.len()));
-                        }
-                        check_zero_derivatives(s, &[(f, z)], d)?;
-                        if let Some(m) = delay {
-                            let t0 = start.as_ref().map_err(|e| format!("report failed: {e}"))?;
-                            let tau = 2.0 * z / (2.0 * PI * f)
-                                + imps.iter().map(|p| p.1 * (p.0 + t0)).sum::<f64>();
-                            if (tau - m as f64 * period).abs() > 1e-8 * (1.0 + tau.abs()) {
-                                return Err(format!(
-                                    "ramp delay {tau} s instead of {}",
-                                    m as f64 * period
+                                    "V = {got} at {f} Hz, product of factors {product}"
                                 ));
                             }
                         }
@@ -524,15 +457,117 @@ fn run(axes: &Axes) {
         }
     }
 
+    // Direct multi-mode: V and n derivatives zero at every mode; no longer than the convolved
+    // ZV-Dⁿ (a feasible point of the same program, so the shortest cannot exceed it).
+    if grid.wants("direct") {
+        for set in &axes.mode_sets {
+            for &z in &axes.zetas {
+                for &d in &axes.direct_derivatives {
+                    let spec = DirectSpec {
+                        derivatives: d,
+                        ..DirectSpec::default()
+                    };
+                    let what = format!("direct n={d} modes={set:?} ζ={z}");
+                    let points: Vec<(f64, f64)> = set.iter().map(|&f| (f, z)).collect();
+                    let convolved: Option<f64> = set
+                        .iter()
+                        .map(|&f| Mode::new(f, z).and_then(|m| zero_vibration::zv_dn(&m, d)))
+                        .try_fold(Shaper::identity(), |acc, s| acc.convolve(&s?))
+                        .ok()
+                        .map(|s| s.duration());
+                    grid.point(
+                        "direct",
+                        what,
+                        design(&spec.request(modes_of(set, z))),
+                        |s| {
+                            amplitudes_in(&pairs(s), 0.0, 1.0)?;
+                            check_zero_derivatives(s, &points, d)?;
+                            if let Some(c) = convolved {
+                                if s.duration() > c * 1.01 {
+                                    return Err(format!(
+                                        "duration {} s longer than the convolved shaper's {c} s",
+                                        s.duration()
+                                    ));
+                                }
+                            }
+                            Ok(())
+                        },
+                    );
+                }
+            }
+        }
+    }
+
+    // Sampled (Kamel et al.): impulses on t = iT, Σ A = 1, V and derivatives zero at the mode,
+    // and the prescribed ramp delay τ = 2ζ/ω + Σ Aᵢtᵢ = mT when asked.
+    if grid.wants("sampled") {
+        for &z in &axes.zetas {
+            for &(wt, n) in &axes.sampled {
+                for d in 0..=2u32 {
+                    for delay in [None, Some(n as u32 / 2)] {
+                        let f = 1.0;
+                        let period = wt / (2.0 * PI * f);
+                        let spec = SampledSpec {
+                            derivatives: d,
+                            delay_samples: delay,
+                            ..SampledSpec::new(period, n)
+                        };
+                        let request = DesignRequest {
+                            modes: modes_of(&[f], z),
+                            shaper: ShaperSpec::Sampled(spec.clone()),
+                        };
+                        let what = format!("sampled ωT={wt} n={n} d={d} m={delay:?} ζ={z}");
+                        let start = Mode::new(f, z)
+                            .and_then(|m| sampled::report(&[m], &spec))
+                            .map(|r| r.start_time);
+                        grid.point("sampled", what, design(&request), |s| {
+                            let imps = pairs(s);
+                            let sum: f64 = imps.iter().map(|p| p.1).sum();
+                            if (sum - 1.0).abs() > 1e-9 {
+                                return Err(format!("Σ A = {sum}"));
+                            }
+                            for p in &imps {
+                                let k = p.0 / period;
+                                if (k - k.round()).abs() > 1e-6 {
+                                    return Err(format!(
+                                        "impulse at {} s is not on the period grid",
+                                        p.0
+                                    ));
+                                }
+                            }
+                            if imps.len() > n {
+                                return Err(format!("{} impulses, more than {n}", imps.len()));
+                            }
+                            check_zero_derivatives(s, &[(f, z)], d)?;
+                            if let Some(m) = delay {
+                                let t0 =
+                                    start.as_ref().map_err(|e| format!("report failed: {e}"))?;
+                                let tau = 2.0 * z / (2.0 * PI * f)
+                                    + imps.iter().map(|p| p.1 * (p.0 + t0)).sum::<f64>();
+                                if (tau - m as f64 * period).abs() > 1e-8 * (1.0 + tau.abs()) {
+                                    return Err(format!(
+                                        "ramp delay {tau} s instead of {}",
+                                        m as f64 * period
+                                    ));
+                                }
+                            }
+                            Ok(())
+                        });
+                    }
+                }
+            }
+        }
+    }
+
     grid.report_and_assert();
 }
 
-/// The quick grid (`npm test`): every family and every axis touched, corners included.
-#[test]
-fn quick_grid() {
-    run(&Axes {
-        zetas: vec![0.0, 0.1, 0.3],
-        insens: vec![0.1, 0.5, 1.0, 1.5],
+/// The quick grid (`npm test`): every family and every axis touched, corners included; one
+/// test per family group so they run side by side and each reports its own counts.
+fn quick_axes() -> Axes {
+    Axes {
+        zetas: vec![0.0, 0.3],
+        insens: vec![0.1, 0.8, 1.5],
         vtols: vec![0.01, 0.1],
         mode_sets: vec![
             vec![1.0],
@@ -545,7 +580,27 @@ fn quick_grid() {
         direct_derivatives: vec![0, 1, 2],
         sampled: vec![(0.3, 24), (1.0, 12)],
         damping_halfwidths: vec![0.05],
-    });
+    }
+}
+
+#[test]
+fn quick_grid_si() {
+    run(&quick_axes(), &["si", "si-damping"]);
+}
+
+#[test]
+fn quick_grid_si_modes() {
+    run(&quick_axes(), &["si-modes"]);
+}
+
+#[test]
+fn quick_grid_ei() {
+    run(&quick_axes(), &["ei", "ei-modes"]);
+}
+
+#[test]
+fn quick_grid_direct_sampled() {
+    run(&quick_axes(), &["direct", "sampled"]);
 }
 
 /// The full grid: `cargo test --profile bench --test convergence -- --ignored --nocapture`.
@@ -559,25 +614,36 @@ fn full_grid() {
     };
     let round =
         |v: Vec<f64>| -> Vec<f64> { v.into_iter().map(|x| (x * 1e6).round() / 1e6).collect() };
-    run(&Axes {
-        zetas: round(lin(0.0, 0.3, 7)),
-        insens: round(lin(0.1, 1.5, 8)),
-        vtols: vec![0.01, 0.02, 0.05, 0.1],
-        mode_sets: vec![
-            vec![1.0],
-            vec![1.0, 1.1],
-            vec![1.0, 1.5],
-            vec![1.0, 3.0],
-            vec![1.0, 10.0],
-            vec![1.0, 1.1, 1.21],
-            vec![1.0, 2.5, 6.0],
-            vec![1.0, 3.0, 10.0],
-            vec![1.0, 1.1, 3.0, 10.0],
-            vec![1.0, 2.0, 4.0, 8.0],
+    run(
+        &Axes {
+            zetas: round(lin(0.0, 0.3, 7)),
+            insens: round(lin(0.1, 1.5, 8)),
+            vtols: vec![0.01, 0.02, 0.05, 0.1],
+            mode_sets: vec![
+                vec![1.0],
+                vec![1.0, 1.1],
+                vec![1.0, 1.5],
+                vec![1.0, 3.0],
+                vec![1.0, 10.0],
+                vec![1.0, 1.1, 1.21],
+                vec![1.0, 2.5, 6.0],
+                vec![1.0, 3.0, 10.0],
+                vec![1.0, 1.1, 3.0, 10.0],
+                vec![1.0, 2.0, 4.0, 8.0],
+            ],
+            humps: vec![1, 2, 3, 4],
+            direct_derivatives: vec![0, 1, 2],
+            sampled: vec![(0.2, 32), (0.3, 24), (0.6, 16), (1.0, 12), (2.0, 10)],
+            damping_halfwidths: vec![0.02, 0.05, 0.1],
+        },
+        &[
+            "si",
+            "si-damping",
+            "si-modes",
+            "ei",
+            "ei-modes",
+            "direct",
+            "sampled",
         ],
-        humps: vec![1, 2, 3, 4],
-        direct_derivatives: vec![0, 1, 2],
-        sampled: vec![(0.2, 32), (0.3, 24), (0.6, 16), (1.0, 12), (2.0, 10)],
-        damping_halfwidths: vec![0.02, 0.05, 0.1],
-    });
+    );
 }
