@@ -57,18 +57,20 @@ impl Grid {
         check: impl FnOnce(&Shaper) -> Result<(), String>,
     ) {
         let seconds = self.last.elapsed().as_secs_f64();
-        let outcome = match &result {
-            Ok(_) => "ok",
-            Err(_) => "error",
-        };
-        eprintln!("  [{seconds:6.2} s] {what}: {outcome}");
         let tally = self.families.entry(family).or_default();
         match result {
             Ok(shaper) => match check_valid(&shaper).and_then(|_| check(&shaper)) {
-                Ok(()) => tally.ok += 1,
-                Err(why) => tally.wrong.push(format!("{what}: {why}")),
+                Ok(()) => {
+                    eprintln!("  [{seconds:6.2} s] {what}: ok");
+                    tally.ok += 1
+                }
+                Err(why) => {
+                    eprintln!("  [{seconds:6.2} s] {what}: WRONG {why}");
+                    tally.wrong.push(format!("{what}: {why}"))
+                }
             },
             Err(e) => {
+                eprintln!("  [{seconds:6.2} s] {what}: error: {e}");
                 let kind = match &e {
                     Error::Infeasible { .. } => "infeasible",
                     Error::InvalidInput { .. } => "invalid",
