@@ -111,7 +111,9 @@ async function errorShown(page) {
 
 test('every input and select, one by one: errors shown next to it, last good result kept', async () => {
   const { page, problems } = await env.page();
-  const good = '#state=' + encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: 2, damping: 0.05 }], shapers: [{ family: 'zvd' }], view: { vtol: 0.05, scv: 5 } }));
+  // Two good states, alternated so that every reset really changes the hash (and reloads).
+  const good = (k) => '#state=' + encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: k % 2 ? 2 : 2.5, damping: 0.05 }], shapers: [{ family: 'zvd' }], view: { vtol: 0.05, scv: 5 } }));
+  let resets = 0;
   const selector = 'input:not([type=file]):not([type=hidden]):not([readonly]), select, textarea:not([readonly])';
   const count = (await page.$$(selector)).length;
   let visible = 0;
@@ -120,7 +122,7 @@ test('every input and select, one by one: errors shown next to it, last good res
   let touched = 0;
   for (let i = 0; i < count; i++) {
     for (const text of SWEEP) {
-      await page.evaluate((h) => { location.hash = h; }, good);
+      await page.evaluate((h) => { location.hash = h; }, good(resets++));
       await frame(page);
       const inputs = await page.$$(selector);
       if (i >= inputs.length) break;
