@@ -114,6 +114,7 @@ test('every input and select, one by one: errors shown next to it, last good res
   // Two good states, alternated so that every reset really changes the hash (and reloads).
   const good = (k) => '#state=' + encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: k % 2 ? 2 : 2.5, damping: 0.05 }], shapers: [{ family: 'zvd' }], view: { vtol: 0.05, scv: 5 } }));
   let resets = 0;
+  let errorsSeen = 0;
   const selector = 'input:not([type=file]):not([type=hidden]):not([readonly]), select, textarea:not([readonly])';
   const count = (await page.$$(selector)).length;
   let visible = 0;
@@ -145,11 +146,15 @@ test('every input and select, one by one: errors shown next to it, last good res
       assert.ok((await canvasInfo(page, 'impulses-chart')).ink > 500, `impulse chart blank after input ${i}`);
       assert.ok((await canvasInfo(page, 'sensitivity-chart')).ink > 500, `sensitivity chart blank after input ${i}`);
       if (await errorShown(page)) {
+        errorsSeen++;
         assert.equal(await tableText(page), before, `input ${i} (${tag}) = ${JSON.stringify(text)}: error shown but the result changed`);
       }
       if (tag === 'SELECT' || kind === 'checkbox' || kind === 'radio') break;
     }
   }
   assert.ok(touched >= visible, `touched ${touched} of ${visible} visible inputs`);
+  // The sweep must have provoked errors (NaN, '', 1e309 in number fields), or it checked nothing.
+  assert.ok(errorsSeen >= visible, `only ${errorsSeen} errors shown over ${visible} inputs`);
+  console.log(`# sweep: ${touched} inputs, ${errorsSeen} errors shown, last good result kept each time`);
   await page.close();
 });
