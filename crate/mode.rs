@@ -12,6 +12,9 @@ use std::f64::consts::PI;
 pub const MIN_FREQUENCY_HZ: f64 = 1e-9;
 /// Largest natural frequency accepted, in Hz.
 pub const MAX_FREQUENCY_HZ: f64 = 1e9;
+/// Most modes a list may hold (a spec with more is refused: checking a list for repeats, and
+/// every design on it, grows with its length).
+pub const MAX_MODES: usize = 64;
 
 /// A validated vibration mode: `0 < frequency_hz` (within [`MIN_FREQUENCY_HZ`],
 /// [`MAX_FREQUENCY_HZ`]) and `0 ≤ damping < 1`.
@@ -78,6 +81,7 @@ impl Mode {
         if specs.is_empty() {
             return Err(Error::invalid("modes", "at least one mode is required"));
         }
+        crate::error::count("modes", specs.len(), 1, MAX_MODES)?;
         let mut modes = Vec::with_capacity(specs.len());
         for (i, spec) in specs.iter().enumerate() {
             let mode = Mode::from_spec(spec).map_err(|e| e.within(&format!("modes[{i}]")))?;

@@ -9,6 +9,12 @@ use serde::{Deserialize, Serialize};
 
 /// Most impulses a shaper may hold (keeps memory and every evaluation bounded).
 pub const MAX_IMPULSES: usize = 4096;
+/// Largest |amplitude| accepted. Shapers' amplitudes are fractions of the command (±2 for
+/// bang-bang); beyond this, sums of a few thousand impulses and V itself could overflow f64.
+pub const MAX_AMPLITUDE: f64 = 1e12;
+/// Latest impulse time accepted, in seconds: 40 periods of the slowest mode the library
+/// accepts (10⁻⁹ Hz) with room to spare; beyond it, phases and products of times overflow.
+pub const MAX_TIME_S: f64 = 1e12;
 
 /// One impulse of a shaper: amplitude `amplitude` applied at `time` seconds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -46,7 +52,8 @@ impl Shaper {
     /// amplitude are kept only if nothing else remains.
     ///
     /// Errors: an empty list, more than [`MAX_IMPULSES`], a non-finite time or amplitude, a
-    /// negative time, or amplitudes that are all zero.
+    /// negative time, a time beyond [`MAX_TIME_S`] or an |amplitude| beyond [`MAX_AMPLITUDE`]
+    /// (also after merging), or amplitudes that are all zero.
     pub fn new(impulses: Vec<Impulse>) -> Result<Self> {
         if impulses.is_empty() {
             return Err(Error::invalid(
@@ -70,6 +77,20 @@ impl Shaper {
                     format!("must be ≥ 0 s, got {}", imp.time),
                 ));
             }
+            if imp.time > MAX_TIME_S {
+                return Err(Error::TooLarge {
+                    field: format!("impulses[{i}].time"),
+                    value: imp.time,
+                    limit: MAX_TIME_S,
+                });
+            }
+            if imp.amplitude.abs() > MAX_AMPLITUDE {
+                return Err(Error::TooLarge {
+                    field: format!("impulses[{i}].amplitude"),
+                    value: imp.amplitude.abs(),
+                    limit: MAX_AMPLITUDE,
+                });
+            }
         }
         if impulses.iter().all(|imp| imp.amplitude == 0.0) {
             return Err(Error::invalid("impulses", "all amplitudes are zero"));
@@ -89,6 +110,20 @@ impl Shaper {
                     amplitude: imp.amplitude,
                 }),
             }
+        }
+        // Amplitudes near f64::MAX can overflow when merged (or when a convolution or
+        // normalisation produced them): refuse rather than return an infinite impulse.
+        if let Some(k) = merged
+            .iter()
+            .position(|imp| imp.amplitude.is_nan() || imp.amplitude.abs() > MAX_AMPLITUDE)
+        {
+            return Err(Error::invalid(
+                format!("impulses[{k}].amplitude"),
+                format!(
+                    "combining impulses at the same time gives an amplitude beyond \
+                     {MAX_AMPLITUDE:e}"
+                ),
+            ));
         }
         merged.retain(|imp| imp.amplitude != 0.0);
         if merged.is_empty() {
@@ -151,19 +186,20 @@ impl Shaper {
     }
 
     /// Centroid delay Σ Aᵢtᵢ / Σ Aᵢ in seconds: the delay a slow ramp sees through the shaper
-    /// (Kamel et al. eq. 10 without the plant's own 2ζ/ω). `None` when the amplitudes sum to 0.
+    /// (Kamel et al. eq. 10 without the plant's own 2ζ/ω). `None` when the amplitudes sum to 0,
+    /// or when the sums overflow (amplitudes near f64::MAX).
     pub fn centroid_delay(&self) -> Option<f64> {
         let sum = self.amplitude_sum();
         if sum.abs() < 1e-15 {
             return None;
         }
-        Some(
-            self.impulses
-                .iter()
-                .map(|imp| imp.amplitude * imp.time)
-                .sum::<f64>()
-                / sum,
-        )
+        let delay = self
+            .impulses
+            .iter()
+            .map(|imp| imp.amplitude * imp.time)
+            .sum::<f64>()
+            / sum;
+        delay.is_finite().then_some(delay)
     }
 
     /// The convolution of two shapers: every pair of impulses multiplied, times added.

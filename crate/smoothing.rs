@@ -38,8 +38,8 @@ pub struct KlipperFigures {
 /// Smoothing (mm) of `shaper` at acceleration `accel` (mm/s²) and square corner velocity `scv`
 /// (mm/s), as Klipper's `_get_shaper_smoothing`. Times are in seconds.
 pub fn smoothing(shaper: &Shaper, accel: f64, scv: f64) -> Result<f64> {
-    finite("accel", accel)?;
-    finite("scv", scv)?;
+    in_range("accel", accel)?;
+    in_range("scv", scv)?;
     let d = shaper.amplitude_sum();
     let ts = shaper.centroid_delay().ok_or_else(|| {
         Error::invalid(
@@ -56,17 +56,41 @@ pub fn smoothing(shaper: &Shaper, accel: f64, scv: f64) -> Result<f64> {
         }
         o180 += imp.amplitude * half * dt * dt;
     }
-    Ok((o90 * std::f64::consts::SQRT_2 / d).max(o180 / d))
+    let smoothing = (o90 * std::f64::consts::SQRT_2 / d).max(o180 / d);
+    if smoothing.is_finite() {
+        Ok(smoothing)
+    } else {
+        Err(Error::invalid(
+            "impulses",
+            format!("smoothing overflows ({smoothing}) for this shaper at {accel} mm/s²"),
+        ))
+    }
+}
+
+/// Largest acceleration or square corner velocity accepted (mm/s², mm/s).
+pub const MAX_FIGURE_INPUT: f64 = 1e12;
+
+/// Checks that an acceleration or velocity is finite and in [0, [`MAX_FIGURE_INPUT`]].
+fn in_range(field: &str, value: f64) -> Result<f64> {
+    finite(field, value)?;
+    if !(0.0..=MAX_FIGURE_INPUT).contains(&value) {
+        return Err(Error::invalid(
+            field,
+            format!("must lie between 0 and {MAX_FIGURE_INPUT:e}, got {value}"),
+        ));
+    }
+    Ok(value)
 }
 
 /// Klipper's suggested maximum acceleration: the largest `accel` with smoothing ≤ 0.12 mm,
 /// found by Klipper's own bisection (`_bisect`, to 1e-8 mm/s²), bounded to 4096 steps.
 ///
 /// A shaper of zero duration (a single impulse) never smooths: its maximum acceleration is
-/// unbounded and `f64::INFINITY` is returned (`null` in JS).
+/// unbounded and `f64::INFINITY` is returned (`null` in JS). The search stops at
+/// [`MAX_FIGURE_INPUT`] (10¹² mm/s²), which is returned if smoothing is still below target there.
 pub fn max_accel(shaper: &Shaper, scv: f64) -> Result<f64> {
     if shaper.duration() == 0.0 {
-        finite("scv", scv)?;
+        in_range("scv", scv)?;
         return Ok(f64::INFINITY);
     }
     let ok =
@@ -83,7 +107,11 @@ pub fn max_accel(shaper: &Shaper, scv: f64) -> Result<f64> {
     }
     if right == left {
         while ok(right)? && steps < 4096 {
-            right *= 2.0;
+            if right >= MAX_FIGURE_INPUT {
+                // Smoothing stays below target up to the largest acceleration accepted.
+                return Ok(MAX_FIGURE_INPUT);
+            }
+            right = (right * 2.0).min(MAX_FIGURE_INPUT);
             steps += 1;
         }
     }

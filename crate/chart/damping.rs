@@ -17,24 +17,17 @@ pub fn draw_damping_sensitivity<DB: DrawingBackend>(
     style: &ChartStyle,
 ) -> Result<()> {
     area.fill(&WHITE).map_err(render_error)?;
-    let (z_lo, z_hi) = curves
-        .iter()
-        .flat_map(|(_, c)| c.damping.iter().copied())
-        .filter(|z| z.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| {
-            (lo.min(z), hi.max(z))
-        });
-    let (z_lo, z_hi) = if z_lo < z_hi {
-        (z_lo, z_hi)
-    } else {
-        (0.0, 1.0)
-    };
+    let (z_lo, z_hi) = super::finite_range(
+        curves.iter().flat_map(|(_, c)| c.damping.iter().copied()),
+        (0.0, 1.0),
+    );
+    let vtol = super::drawable_vtol(vtol);
     let v_max = curves
         .iter()
         .flat_map(|(_, c)| c.vibration.iter().copied())
         .filter(|v| v.is_finite())
         .fold(vtol.unwrap_or(0.0), f64::max)
-        .max(1e-3)
+        .clamp(1e-3, super::AXIS_LIMIT)
         * 100.0
         * 1.06;
     let mut chart = ChartBuilder::on(area)
@@ -82,7 +75,12 @@ pub fn draw_damping_sensitivity<DB: DrawingBackend>(
                     .iter()
                     .zip(&curve.vibration)
                     .filter(|(z, v)| z.is_finite() && v.is_finite())
-                    .map(|(&z, &v)| (z, v * 100.0)),
+                    .map(|(&z, &v)| {
+                        (
+                            super::clip(z, z_lo, z_hi),
+                            super::clip(v * 100.0, 0.0, v_max),
+                        )
+                    }),
                 color.stroke_width(style.px(2.0)),
             ))
             .map_err(render_error)?

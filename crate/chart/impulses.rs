@@ -17,10 +17,15 @@ pub fn draw_impulses<DB: DrawingBackend>(
         .iter()
         .map(|(_, s)| s.duration())
         .fold(0.0_f64, f64::max);
-    let t_max = if t_max > 0.0 { t_max } else { 1.0 };
+    let t_max = if t_max > 0.0 {
+        t_max.min(super::AXIS_LIMIT)
+    } else {
+        1.0
+    };
     let (a_min, a_max) = shapers
         .iter()
         .flat_map(|(_, s)| s.impulses().iter().map(|imp| imp.amplitude))
+        .map(|a| a.clamp(-super::AXIS_LIMIT, super::AXIS_LIMIT))
         .fold((0.0_f64, 0.0_f64), |(lo, hi), a| (lo.min(a), hi.max(a)));
     let pad = 0.12 * (a_max - a_min).max(1e-9);
     let x_pad = 0.06 * t_max;
@@ -59,7 +64,13 @@ pub fn draw_impulses<DB: DrawingBackend>(
         chart
             .draw_series(shaper.impulses().iter().map(|imp| {
                 PathElement::new(
-                    vec![(imp.time + dx, 0.0), (imp.time + dx, imp.amplitude)],
+                    vec![
+                        (imp.time.min(t_max) + dx, 0.0),
+                        (
+                            imp.time.min(t_max) + dx,
+                            super::clip(imp.amplitude, a_min, a_max),
+                        ),
+                    ],
                     stroke,
                 )
             }))
@@ -70,12 +81,13 @@ pub fn draw_impulses<DB: DrawingBackend>(
             });
         let r = style.px(4.0);
         chart
-            .draw_series(
-                shaper
-                    .impulses()
-                    .iter()
-                    .map(|imp| Circle::new((imp.time + dx, imp.amplitude), r, color.filled())),
-            )
+            .draw_series(shaper.impulses().iter().map(|imp| {
+                let at = (
+                    imp.time.min(t_max) + dx,
+                    super::clip(imp.amplitude, a_min, a_max),
+                );
+                Circle::new(at, r, color.filled())
+            }))
             .map_err(render_error)?;
     }
     if shapers.len() > 1 {

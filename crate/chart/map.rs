@@ -168,13 +168,14 @@ pub fn draw_sensitivity_map<DB: DrawingBackend>(
 ) -> Result<()> {
     check_map(map)?;
     area.fill(&WHITE).map_err(render_error)?;
+    let vtol = super::drawable_vtol(vtol);
     let top = map
         .vibration
         .iter()
         .copied()
         .filter(|v| v.is_finite())
         .fold(vtol.unwrap_or(0.0), f64::max)
-        .max(1e-3);
+        .clamp(1e-3, super::AXIS_LIMIT);
     let (width, _) = area.dim_in_pixel();
     let bar_width = style.px(78.0).min(width / 3);
     let (main, bar) = area.split_horizontally(width.saturating_sub(bar_width).max(1));

@@ -63,6 +63,42 @@ impl ChartStyle {
     }
 }
 
+/// Largest magnitude an axis may span: plotters maps coordinates to `i32` pixels, so a value
+/// far outside the axes (or a range of 10³⁰⁰) would overflow inside it.
+pub(crate) const AXIS_LIMIT: f64 = 1e15;
+
+/// A value made drawable: NaN to `lo`, everything else clamped to the axis range widened by
+/// its span on each side (a line to a far point still leaves the plot, at a sane angle).
+pub(crate) fn clip(v: f64, lo: f64, hi: f64) -> f64 {
+    let span = (hi - lo).abs();
+    if v.is_nan() {
+        lo
+    } else {
+        v.clamp(lo - span, hi + span)
+    }
+}
+
+/// `(lo, hi)` of the finite `values` (each clamped to ±[`AXIS_LIMIT`]), or `fallback` when
+/// they do not span an interval.
+pub(crate) fn finite_range(values: impl Iterator<Item = f64>, fallback: (f64, f64)) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .map(|v| v.clamp(-AXIS_LIMIT, AXIS_LIMIT))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo < hi {
+        (lo, hi)
+    } else {
+        fallback
+    }
+}
+
+/// A tolerable-vibration level worth drawing: finite, positive and below [`AXIS_LIMIT`].
+pub(crate) fn drawable_vtol(vtol: Option<f64>) -> Option<f64> {
+    vtol.filter(|v| v.is_finite() && *v > 0.0 && *v < AXIS_LIMIT)
+}
+
 /// Converts a plotters error into the crate's.
 pub(crate) fn render_error<E: std::fmt::Debug>(e: E) -> Error {
     Error::Render {

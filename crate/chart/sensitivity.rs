@@ -17,23 +17,19 @@ pub fn draw_sensitivity<DB: DrawingBackend>(
     style: &ChartStyle,
 ) -> Result<()> {
     area.fill(&WHITE).map_err(render_error)?;
-    let (f_lo, f_hi) = curves
-        .iter()
-        .flat_map(|(_, c)| c.frequency_hz.iter().copied())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
-            (lo.min(f), hi.max(f))
-        });
-    let (f_lo, f_hi) = if f_lo < f_hi {
-        (f_lo, f_hi)
-    } else {
-        (0.0, 1.0)
-    };
+    let (f_lo, f_hi) = super::finite_range(
+        curves
+            .iter()
+            .flat_map(|(_, c)| c.frequency_hz.iter().copied()),
+        (0.0, 1.0),
+    );
+    let vtol = super::drawable_vtol(vtol);
     let v_max = curves
         .iter()
         .flat_map(|(_, c)| c.vibration.iter().copied())
         .filter(|v| v.is_finite())
         .fold(vtol.unwrap_or(0.0), f64::max)
-        .max(1e-3)
+        .clamp(1e-3, super::AXIS_LIMIT)
         * 100.0
         * 1.06;
     let mut chart = ChartBuilder::on(area)
@@ -80,8 +76,13 @@ pub fn draw_sensitivity<DB: DrawingBackend>(
                     .frequency_hz
                     .iter()
                     .zip(&curve.vibration)
-                    .filter(|(_, v)| v.is_finite())
-                    .map(|(&f, &v)| (f, v * 100.0)),
+                    .filter(|(f, v)| f.is_finite() && v.is_finite())
+                    .map(|(&f, &v)| {
+                        (
+                            super::clip(f, f_lo, f_hi),
+                            super::clip(v * 100.0, 0.0, v_max),
+                        )
+                    }),
                 color.stroke_width(style.px(2.0)),
             ))
             .map_err(render_error)?

@@ -297,8 +297,30 @@ fn check_frequency(field: &str, f: f64) -> Result<()> {
     Ok(())
 }
 
+/// Most zero-vibration constraints (modes) a problem may have.
+pub const MAX_ZEROS: usize = crate::mode::MAX_MODES;
+/// Most zero derivatives per mode (each adds two equality rows per derivative).
+pub const MAX_ZERO_DERIVATIVES: u32 = crate::design::direct::MAX_DIRECT_DERIVATIVES;
+/// Most sampled limits (200 frequencies at up to 64 damping ratios).
+pub const MAX_LIMITS: usize = 200 * crate::mode::MAX_MODES;
+/// Most bands.
+pub const MAX_BANDS: usize = crate::mode::MAX_MODES;
+
 impl NormalizedProblem {
     fn new(p: &Problem) -> Result<Self> {
+        // Sizes first, so nothing below (or in the programs) grows without bound.
+        crate::error::count("modes", p.zeros.len(), 0, MAX_ZEROS)?;
+        crate::error::count("sampleFrequenciesHz", p.limits.len(), 0, MAX_LIMITS)?;
+        crate::error::count("bands", p.bands.len(), 0, MAX_BANDS)?;
+        for z in &p.zeros {
+            if z.derivatives > MAX_ZERO_DERIVATIVES {
+                return Err(Error::TooLarge {
+                    field: "derivatives".into(),
+                    value: f64::from(z.derivatives),
+                    limit: f64::from(MAX_ZERO_DERIVATIVES),
+                });
+            }
+        }
         finite("amplitudeMin", p.amplitude_min)?;
         finite("amplitudeMax", p.amplitude_max)?;
         if p.amplitude_max <= 0.0 || p.amplitude_min >= p.amplitude_max || p.amplitude_min > 1.0 {
@@ -477,10 +499,29 @@ pub fn minimum_duration(problem: &Problem) -> Result<Design> {
             )?;
             polished = polish::polish(&norm, &grid);
         }
-        let (impulses, polished) = match polished {
+        // The polish and the fallback's projection solve equalities and may step outside the
+        // amplitude bounds (the convergence grid found direct ZVDD designs with amplitudes down
+        // to −0.008 at amplitudeMin = 0): a result outside them is not accepted.
+        let (impulses, polished) = match polished.filter(|p| within_bounds(&norm, p)) {
             Some(imps) => (imps, true),
             None => (fallback(&norm, &samples, &grid, &mut programs)?, false),
         };
+        if !within_bounds(&norm, &impulses) {
+            let worst = impulses
+                .iter()
+                .map(|i| i.amplitude)
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), a| {
+                    (lo.min(a), hi.max(a))
+                });
+            return Err(Error::Infeasible {
+                reason: format!(
+                    "the design's amplitudes ({:.6} … {:.6}) leave the bounds [{}, {}] when its \
+                     constraints are solved exactly: the problem is numerically degenerate here \
+                     (modes very close, many derivatives); widen the bounds or drop a derivative",
+                    worst.0, worst.1, norm.amplitude_min, norm.amplitude_max
+                ),
+            });
+        }
         let report = scan::check(&norm, &impulses);
         if report.worst_limit > 1.0 + CHECK_TOLERANCE || report.worst_moment > ZERO_TOLERANCE {
             // Not something more samples can fix: the numbers are at their limits.
@@ -844,6 +885,17 @@ fn refine_pattern(grid: &GridSolution) -> Vec<f64> {
 /// the amplitudes re-solved there (and the equalities made exact by projection). The support
 /// is the points above 10⁻⁶ of the largest amplitude (the interior-point solver leaves ~10⁻¹⁰
 /// elsewhere); if the program is not feasible on it, every point above 10⁻⁹ is kept.
+/// Amplitude bound slack, relative to the bounds' range: the solver's tolerance, not more.
+const BOUND_TOLERANCE: f64 = 1e-8;
+
+/// Every amplitude within [amplitudeMin, amplitudeMax] up to [`BOUND_TOLERANCE`].
+fn within_bounds(norm: &NormalizedProblem, impulses: &[Impulse]) -> bool {
+    let tol = BOUND_TOLERANCE * (norm.amplitude_max - norm.amplitude_min);
+    impulses
+        .iter()
+        .all(|i| i.amplitude >= norm.amplitude_min - tol && i.amplitude <= norm.amplitude_max + tol)
+}
+
 fn fallback(
     norm: &NormalizedProblem,
     samples: &[NormalizedLimit],

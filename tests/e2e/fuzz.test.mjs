@@ -88,3 +88,73 @@ test(`${STEPS} random inputs and hashes: no exception, never blank, last good re
   assert.deepEqual(problems, []);
   await page.close();
 });
+
+// Every input, select and textarea on the page, one by one (the random walk above may miss
+// some): nasty strings typed into each, every option of each select chosen. After each: no
+// console error or uncaught exception, charts not blank, and whenever the page shows an error
+// (a field marked aria-invalid or an error message) the impulse table is exactly what it was
+// before that input — the last good result is kept.
+const SWEEP = ['NaN', '', '-1', '1e309', 'abc', '0', '<b>x</b>', '1e-320', '-0', '99999999'];
+
+async function frame(page) {
+  await page.evaluate(() => new Promise((res) => requestAnimationFrame(() => requestAnimationFrame(res))));
+}
+
+async function tableText(page) {
+  return page.evaluate(() => document.querySelector('#impulses-0')?.textContent ?? '');
+}
+
+async function errorShown(page) {
+  return page.evaluate(() => document.querySelector('[aria-invalid="true"]') !== null
+    || [...document.querySelectorAll('.error, .group-error, #general-error')].some((e) => e.textContent.trim() !== ''));
+}
+
+test('every input and select, one by one: errors shown next to it, last good result kept', async () => {
+  const { page, problems } = await env.page();
+  // Two good states, alternated so that every reset really changes the hash (and reloads).
+  const good = (k) => '#state=' + encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: k % 2 ? 2 : 2.5, damping: 0.05 }], shapers: [{ family: 'zvd' }], view: { vtol: 0.05, scv: 5 } }));
+  let resets = 0;
+  let errorsSeen = 0;
+  const selector = 'input:not([type=file]):not([type=hidden]):not([readonly]), select, textarea:not([readonly])';
+  const count = (await page.$$(selector)).length;
+  let visible = 0;
+  for (const e of await page.$$(selector)) if (await e.isVisible()) visible++;
+  assert.ok(visible >= 4, `only ${visible} visible inputs found`);
+  let touched = 0;
+  for (let i = 0; i < count; i++) {
+    for (const text of SWEEP) {
+      await page.evaluate((h) => { location.hash = h; }, good(resets++));
+      await frame(page);
+      const inputs = await page.$$(selector);
+      if (i >= inputs.length) break;
+      const input = inputs[i];
+      if (!(await input.isVisible())) break;
+      if (text === SWEEP[0]) touched++;
+      const before = await tableText(page);
+      const tag = await input.evaluate((e) => e.tagName);
+      const kind = await input.evaluate((e) => e.type);
+      if (tag === 'SELECT') {
+        const values = await input.evaluate((e) => [...e.options].map((o) => o.value));
+        await input.selectOption(values[SWEEP.indexOf(text) % values.length]);
+      } else if (kind === 'checkbox' || kind === 'radio') {
+        await input.click();
+      } else {
+        await input.evaluate((e, v) => { e.value = v; e.dispatchEvent(new Event('input', { bubbles: true })); e.dispatchEvent(new Event('change', { bubbles: true })); }, text);
+      }
+      await frame(page);
+      assert.deepEqual(problems, [], `input ${i} (${tag} ${kind}) with ${JSON.stringify(text)}`);
+      assert.ok((await canvasInfo(page, 'impulses-chart')).ink > 500, `impulse chart blank after input ${i}`);
+      assert.ok((await canvasInfo(page, 'sensitivity-chart')).ink > 500, `sensitivity chart blank after input ${i}`);
+      if (await errorShown(page)) {
+        errorsSeen++;
+        assert.equal(await tableText(page), before, `input ${i} (${tag}) = ${JSON.stringify(text)}: error shown but the result changed`);
+      }
+      if (tag === 'SELECT' || kind === 'checkbox' || kind === 'radio') break;
+    }
+  }
+  assert.ok(touched >= visible, `touched ${touched} of ${visible} visible inputs`);
+  // The sweep must have provoked errors (NaN, '', 1e309 in number fields), or it checked nothing.
+  assert.ok(errorsSeen >= visible, `only ${errorsSeen} errors shown over ${visible} inputs`);
+  console.log(`# sweep: ${touched} inputs, ${errorsSeen} errors shown, last good result kept each time`);
+  await page.close();
+});
