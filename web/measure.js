@@ -140,7 +140,7 @@ function showRecommendation(rec) {
 
 function draw() {
   if (!identification) return;
-  const canvas = $('spectrum-chart');
+  const canvas = $('measured-spectrum-chart');
   const ratio = window.devicePixelRatio || 1;
   const width = Math.max(300, canvas.clientWidth || 640);
   canvas.width = Math.round(width * ratio);

@@ -74,17 +74,17 @@ test('a recording is identified, its modes accepted into the editor, and a bad f
   const recommended = await page.textContent('#measure-recommended');
   assert.match(recommended, /^Recommended: /);
   assert.ok((await page.$$('#measure-recommend tbody tr')).length >= 6);
-  const chart = await canvasInfo(page, 'spectrum-chart');
+  const chart = await canvasInfo(page, 'measured-spectrum-chart');
   assert.ok(chart.ink > 3000, `spectrum chart has ink: ${chart.ink}`);
   // The plain FFT magnitude of the whole record, drawn on the same chart.
   await page.selectOption('#measure-view', 'fft');
-  await page.waitForFunction(() => document.getElementById('spectrum-chart').dataset.view === 'fft', null, { timeout: 60000 });
-  assert.notEqual((await canvasInfo(page, 'spectrum-chart')).hash, chart.hash, 'the FFT chart differs from the PSD');
-  assert.ok((await canvasInfo(page, 'spectrum-chart')).ink > 3000, 'the FFT chart has ink');
-  await page.locator('#spectrum-chart').screenshot({ path: `${SCREENSHOTS}measure-fft.png` });
+  await page.waitForFunction(() => document.getElementById('measured-spectrum-chart').dataset.view === 'fft', null, { timeout: 60000 });
+  assert.notEqual((await canvasInfo(page, 'measured-spectrum-chart')).hash, chart.hash, 'the FFT chart differs from the PSD');
+  assert.ok((await canvasInfo(page, 'measured-spectrum-chart')).ink > 3000, 'the FFT chart has ink');
+  await page.locator('#measured-spectrum-chart').screenshot({ path: `${SCREENSHOTS}measure-fft.png` });
   assert.equal(await page.textContent('#measure-error'), '');
   await page.selectOption('#measure-view', 'welch');
-  await page.waitForFunction(() => document.getElementById('spectrum-chart').dataset.view === 'welch');
+  await page.waitForFunction(() => document.getElementById('measured-spectrum-chart').dataset.view === 'welch');
 
   await page.click('#measure-accept');
   await page.waitForFunction(() => document.getElementById('mode-1-frequency') !== null);

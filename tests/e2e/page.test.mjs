@@ -49,6 +49,16 @@ test('the default page shows the ZVD shaper of the closed form and draws both ch
   await page.close();
 });
 
+test('every element id on the page is unique (two canvases once shared one)', async () => {
+  const { page, problems } = await env.page();
+  const ids = await page.$$eval('[id]', (nodes) => nodes.map((n) => n.id));
+  const repeated = [...new Set(ids.filter((id, i) => ids.indexOf(id) !== i))];
+  assert.deepEqual(repeated, [], `repeated ids: ${repeated.join(', ')}`);
+  assert.ok(ids.includes('spectrum-chart') && ids.includes('measured-spectrum-chart'));
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('changing a mode and the family changes the numbers as the core predicts', async () => {
   const { page, problems } = await env.page();
   await page.selectOption('#shaper-0-family', 'zv');
