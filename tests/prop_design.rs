@@ -13,7 +13,7 @@ mod strategies;
 
 use independent::{check_valid, pairs, phasor_derivative, v_eq11};
 use input_shaping::design::{design, design_for};
-use input_shaping::{DesignRequest, Error, Mode, Shaper, ShaperSpec};
+use input_shaping::{DesignRequest, Error, Mode, ModeSpec, Shaper, ShaperSpec};
 use proptest::prelude::*;
 use strategies::*;
 
@@ -231,6 +231,26 @@ proptest! {
 #[test]
 fn design_for_without_modes_is_an_error() {
     assert!(design_for(&ShaperSpec::Zv, &[]).is_err());
+}
+
+/// Found by `sampled_family` (in CI): with the minimum-norm objective and a plant gain of
+/// f64::MAX the report's cost was ∞ − ∞ = NaN; it is now an error on `plantGain`.
+#[test]
+fn sampled_report_with_an_overflowing_plant_gain_is_an_error() {
+    let spec: input_shaping::design::sampled::SampledSpec = serde_json::from_str(
+        r#"{"periodS":0.005,"impulses":255,"derivatives":0,"weight":0.1,
+            "plantGain":1.7976931348623157e308,"objective":"minimumNorm"}"#,
+    )
+    .expect("spec parses");
+    let modes = Mode::list(&[ModeSpec {
+        frequency_hz: 2.4532576592308275,
+        damping: 0.0,
+    }])
+    .expect("mode");
+    match input_shaping::design::sampled::report(&modes, &spec) {
+        Err(e) => assert_eq!(e.field(), Some("plantGain"), "{e}"),
+        Ok(r) => panic!("expected an error, got cost {:?}", r.cost.total),
+    }
 }
 
 /// Found by `solver_on_any_problem`: a zero with 2 922 400 114 derivatives made the solver

@@ -473,6 +473,14 @@ impl Problem {
         let a = DVector::from_column_slice(amplitudes);
         let control_error = (a.transpose() * &psi * &a)[(0, 0)] - 2.0 * a.dot(&theta) + constant;
         let amplitude_penalty = self.weight * a.dot(&a);
+        // The minimum-norm objective never forms the cost matrices, so an absurd plant gain
+        // first shows here (∞ − ∞ = NaN).
+        if !(control_error.is_finite() && amplitude_penalty.is_finite()) {
+            return Err(Error::invalid(
+                "plantGain",
+                "the cost overflows: the plant gain is too large for this mode",
+            ));
+        }
         Ok(Cost {
             total: control_error + amplitude_penalty,
             control_error,
