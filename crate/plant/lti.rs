@@ -56,6 +56,17 @@ struct BlockMaps {
     gamma: Vec<f64>, // m × q, row-major
 }
 
+/// How many 2 × 2 blocks (modes) [`Lti::respond`] marches together in one loop.
+const LANES: usize = 4;
+
+/// Up to [`LANES`] modes marched together: `rows[k]` = (first state of each lane, then second
+/// state of each lane) at sample k; `starts[lane]` = the lane's first state, `usize::MAX` if
+/// the lane is unused.
+struct ModeGroup {
+    starts: [usize; LANES],
+    rows: Vec<[f64; 2 * LANES]>,
+}
+
 /// Samples of the six outputs and the final state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LtiResponse {
@@ -174,9 +185,8 @@ impl Lti {
     /// Three passes, each a tight loop: (1) the command's derivatives w at every sample and the
     /// state jumps of the knots (a knot between two samples contributes e^{M(t − τ)}(impulse,
     /// jumps) at the next sample); (2) each independent block of states marched over all samples,
-    /// x ← Φx + Γw (a mode's 2 × 2 block unrolled); (3) each output row as a sum of whole
-    /// columns (vectorised). The sums are formed in the same order as a sample-by-sample loop
-    /// would form them.
+    /// x ← Φx + Γw, the modes' 2 × 2 blocks [`LANES`] at a time with their input terms formed
+    /// before the recurrence; (3) each output row as a sum of whole columns (vectorised).
     pub fn respond(
         &self,
         command: &Piecewise,
@@ -266,9 +276,51 @@ impl Lti {
             }
         }
 
-        // Pass 2: each block over all samples; xs[j][k] = state j at sample k.
+        // Pass 2: the states over all samples. The 2 × 2 blocks (modes) are marched LANES at a
+        // time in one loop, so their recurrences — each a chain of dependent multiply-adds —
+        // overlap instead of running one after another. Each sample's input term
+        // cₖ = Γ wₖ₋₁ + (the knots' jumps at k) is formed first, off the chain, in the rows
+        // themselves; the chain is then xₖ = Φ xₖ₋₁ + cₖ (a multiply and two adds deep).
+        // Other blocks: xs[j][k] = state j at sample k, marched one block at a time.
+        let pair_blocks: Vec<usize> = (0..self.blocks.len())
+            .filter(|&b| self.blocks[b].1 == 2)
+            .collect();
+        let mut groups: Vec<ModeGroup> = Vec::with_capacity(pair_blocks.len().div_ceil(LANES));
+        for members in pair_blocks.chunks(LANES) {
+            let mut g = GroupMaps {
+                phi: [[0.0; LANES]; 4],
+                gamma: vec![[0.0; 2 * LANES]; q],
+                starts: [usize::MAX; LANES],
+            };
+            for (lane, &b) in members.iter().enumerate() {
+                let bm = &maps[b];
+                g.starts[lane] = self.blocks[b].0;
+                for (p, &v) in g.phi.iter_mut().zip(&bm.phi) {
+                    p[lane] = v;
+                }
+                for (i, gi) in g.gamma.iter_mut().enumerate() {
+                    gi[lane] = bm.gamma.get(i).copied().unwrap_or(0.0);
+                    gi[LANES + lane] = bm.gamma.get(q + i).copied().unwrap_or(0.0);
+                }
+            }
+            let events = (&event_at[..], &event_jump[..], n);
+            let rows = match q {
+                1 => march_group::<1>(&g, &w, events, samples),
+                2 => march_group::<2>(&g, &w, events, samples),
+                3 => march_group::<3>(&g, &w, events, samples),
+                4 => march_group::<4>(&g, &w, events, samples),
+                _ => march_group::<0>(&g, &w, events, samples),
+            };
+            groups.push(ModeGroup {
+                starts: g.starts,
+                rows,
+            });
+        }
         let mut xs: Vec<Vec<f64>> = vec![Vec::new(); n];
         for (bm, &(start, m)) in maps.iter().zip(&self.blocks) {
+            if m == 2 {
+                continue;
+            }
             let mut out: Vec<Vec<f64>> = vec![vec![0.0; samples]; m];
             let mut events = event_at
                 .iter()
@@ -276,54 +328,30 @@ impl Lti {
                 .map(|(&k, jump)| (k, &jump[start..start + m]))
                 .peekable();
             let mut w_prev = w.chunks_exact(q);
-            if let [o0, o1] = &mut out[..] {
-                // A mode (the common block): unrolled, no inner loops over m.
-                let [p00, p01, p10, p11] = [bm.phi[0], bm.phi[1], bm.phi[2], bm.phi[3]];
-                let (g0, g1) = bm.gamma.split_at(q);
-                let (mut x0, mut x1) = (0.0, 0.0);
-                for (k, (y0, y1)) in o0.iter_mut().zip(o1.iter_mut()).enumerate() {
-                    if k > 0 {
-                        let (mut s0, mut s1) = (p00 * x0 + p01 * x1, p10 * x0 + p11 * x1);
-                        if let Some(wp) = w_prev.next() {
-                            for ((a, b), v) in g0.iter().zip(g1).zip(wp) {
-                                s0 += a * v;
-                                s1 += b * v;
-                            }
+            let mut xb = vec![0.0; m];
+            let mut prev = vec![0.0; m];
+            for k in 0..samples {
+                if k > 0 {
+                    prev.copy_from_slice(&xb);
+                    let wp = w_prev.next().unwrap_or(&[]);
+                    for (i, xo) in xb.iter_mut().enumerate() {
+                        let mut s = 0.0;
+                        for (p, xv) in bm.phi[i * m..(i + 1) * m].iter().zip(&prev) {
+                            s += p * xv;
                         }
-                        (x0, x1) = (s0, s1);
+                        for (g, wv) in bm.gamma[i * q..(i + 1) * q].iter().zip(wp) {
+                            s += g * wv;
+                        }
+                        *xo = s;
                     }
-                    while let Some((_, jump)) = events.next_if(|(at, _)| *at == k) {
-                        x0 += jump[0];
-                        x1 += jump[1];
-                    }
-                    (*y0, *y1) = (x0, x1);
                 }
-            } else {
-                let mut xb = vec![0.0; m];
-                let mut prev = vec![0.0; m];
-                for k in 0..samples {
-                    if k > 0 {
-                        prev.copy_from_slice(&xb);
-                        let wp = w_prev.next().unwrap_or(&[]);
-                        for (i, xo) in xb.iter_mut().enumerate() {
-                            let mut s = 0.0;
-                            for (p, xv) in bm.phi[i * m..(i + 1) * m].iter().zip(&prev) {
-                                s += p * xv;
-                            }
-                            for (g, wv) in bm.gamma[i * q..(i + 1) * q].iter().zip(wp) {
-                                s += g * wv;
-                            }
-                            *xo = s;
-                        }
+                while let Some((_, jump)) = events.next_if(|(at, _)| *at == k) {
+                    for (xi, v) in xb.iter_mut().zip(jump) {
+                        *xi += v;
                     }
-                    while let Some((_, jump)) = events.next_if(|(at, _)| *at == k) {
-                        for (xi, v) in xb.iter_mut().zip(jump) {
-                            *xi += v;
-                        }
-                    }
-                    for (o, &v) in out.iter_mut().zip(&xb) {
-                        o[k] = v;
-                    }
+                }
+                for (o, &v) in out.iter_mut().zip(&xb) {
+                    o[k] = v;
                 }
             }
             for (i, o) in out.into_iter().enumerate() {
@@ -331,13 +359,33 @@ impl Lti {
             }
         }
 
-        // Pass 3: outputs y = C x + D w, row by row over whole columns.
+        // Pass 3: outputs y = C x + D w, row by row over whole columns (a mode group's rows
+        // at once).
         let mut outputs: [Vec<f64>; OUTPUTS] = Default::default();
         for (row, out) in outputs.iter_mut().enumerate() {
             *out = vec![0.0; samples];
+            for g in &groups {
+                let mut coef = [0.0; 2 * LANES];
+                for (lane, &start) in g.starts.iter().enumerate() {
+                    if start != usize::MAX {
+                        coef[lane] = self.c[(row, start)];
+                        coef[LANES + lane] = self.c[(row, start + 1)];
+                    }
+                }
+                let (first, second) = coef.split_at(LANES);
+                match (
+                    first.iter().any(|&c| c != 0.0),
+                    second.iter().any(|&c| c != 0.0),
+                ) {
+                    (true, true) => accumulate_rows::<0, { 2 * LANES }>(out, &g.rows, &coef),
+                    (true, false) => accumulate_rows::<0, LANES>(out, &g.rows, &coef),
+                    (false, true) => accumulate_rows::<LANES, LANES>(out, &g.rows, &coef),
+                    (false, false) => {}
+                }
+            }
             for (j, xj) in xs.iter().enumerate() {
                 let c = self.c[(row, j)];
-                if c != 0.0 {
+                if c != 0.0 && !xj.is_empty() {
                     for (y, x) in out.iter_mut().zip(xj) {
                         *y += c * x;
                     }
@@ -353,9 +401,22 @@ impl Lti {
             }
         }
         let states = keep_states.then(|| {
+            // Where state j lives: (group, slot) of a mode group, or xs[j].
+            let mut at: Vec<Option<(usize, usize)>> = vec![None; n];
+            for (gi, g) in groups.iter().enumerate() {
+                for (lane, &start) in g.starts.iter().enumerate() {
+                    if start != usize::MAX {
+                        at[start] = Some((gi, lane));
+                        at[start + 1] = Some((gi, LANES + lane));
+                    }
+                }
+            }
             let mut s = Vec::with_capacity(n * samples);
             for k in 0..samples {
-                s.extend(xs.iter().map(|xj| xj[k]));
+                s.extend(at.iter().zip(&xs).map(|(loc, xj)| match *loc {
+                    Some((gi, slot)) => groups[gi].rows[k][slot],
+                    None => xj[k],
+                }));
             }
             s
         });
@@ -368,6 +429,42 @@ impl Lti {
 /// `state.len()` derivatives only).
 #[inline]
 fn taylor_shift(state: &[f64], h: f64, out: &mut [f64]) {
+    // The common degrees (step, ramp, trapezoid, S-curve) with the loops unrolled: called for
+    // every sample, where the general loop's bookkeeping cost more than the sums.
+    match (state.len(), out.len()) {
+        (1, 1) => taylor_shift_fixed::<1>(state, h, out),
+        (2, 2) => taylor_shift_fixed::<2>(state, h, out),
+        (3, 3) => taylor_shift_fixed::<3>(state, h, out),
+        (4, 4) => taylor_shift_fixed::<4>(state, h, out),
+        _ => taylor_shift_any(state, h, out),
+    }
+}
+
+/// [`taylor_shift`] for `Q` derivatives (`state.len() == out.len() == Q`).
+#[inline(always)]
+fn taylor_shift_fixed<const Q: usize>(state: &[f64], h: f64, out: &mut [f64]) {
+    let mut st = [0.0; Q];
+    for (d, v) in st.iter_mut().zip(state) {
+        *d = *v;
+    }
+    // hp[i] = hⁱ/i! by the recurrence pw *= h / i, as `command::taylor_shift` forms it (the
+    // constant divisions by 1 and 2 are exact, so the compiler turns them into moves and
+    // multiplications without changing a bit).
+    let mut hp = [1.0; Q];
+    for i in 1..Q {
+        hp[i] = hp[i - 1] * (h / i as f64);
+    }
+    for (k, o) in out.iter_mut().enumerate().take(Q) {
+        let mut sum = 0.0;
+        for i in 0..Q - k {
+            sum += st[k + i] * hp[i];
+        }
+        *o = sum;
+    }
+}
+
+/// [`taylor_shift`] for any number of derivatives.
+fn taylor_shift_any(state: &[f64], h: f64, out: &mut [f64]) {
     for (k, o) in out.iter_mut().enumerate() {
         let mut sum = 0.0;
         let mut pw = 1.0; // h^{m-k}/(m-k)!
@@ -378,6 +475,83 @@ fn taylor_shift(state: &[f64], h: f64, out: &mut [f64]) {
             sum += s * pw;
         }
         *o = sum;
+    }
+}
+
+/// The exact one-step maps of up to [`LANES`] modes, lane by lane: `phi[r][lane]` is entry r
+/// of the lane's row-major Φ; `gamma[i]` = (Γ's first row, then its second row) at the
+/// command's i-th derivative; `starts[lane]` the lane's first state (`usize::MAX`: unused).
+struct GroupMaps {
+    phi: [[f64; LANES]; 4],
+    gamma: Vec<[f64; 2 * LANES]>,
+    starts: [usize; LANES],
+}
+
+/// The states of a group of modes at every sample: xₖ = Φ xₖ₋₁ + cₖ with
+/// cₖ = Γ wₖ₋₁ + (the knots' jumps at k), x₋₁ = 0, all lanes in one loop. The input term is
+/// formed off the recurrence's dependency chain (it needs only w), so the chain per sample is
+/// one multiply and two adds and the lanes' chains overlap. `Q` is the number of command
+/// derivatives per sample, or 0 for "as many as `g.gamma` has" (the loops are then not
+/// unrolled). `events` = (sample index of each event, n jumps per event, n).
+fn march_group<const Q: usize>(
+    g: &GroupMaps,
+    w: &[f64],
+    (event_at, event_jump, n): (&[usize], &[f64], usize),
+    samples: usize,
+) -> Vec<[f64; 2 * LANES]> {
+    let q = if Q == 0 { g.gamma.len() } else { Q };
+    let mut gamma = [[0.0; 2 * LANES]; ORDER];
+    for (d, s) in gamma.iter_mut().zip(&g.gamma) {
+        *d = *s;
+    }
+    let [p00, p01, p10, p11] = g.phi;
+    let mut events = event_at
+        .iter()
+        .zip(event_jump.chunks_exact(n.max(1)))
+        .peekable();
+    let mut rows = Vec::with_capacity(samples);
+    let mut x = [0.0; 2 * LANES];
+    let mut w_prev: &[f64] = &[];
+    for (k, wk) in (0..samples).zip(w.chunks_exact(q.max(1)).chain(std::iter::repeat(&[][..]))) {
+        let mut c = [0.0; 2 * LANES];
+        for (i, wv) in w_prev.iter().enumerate().take(q.min(ORDER)) {
+            for (cl, gl) in c.iter_mut().zip(&gamma[i]) {
+                *cl += gl * wv;
+            }
+        }
+        while let Some((_, jump)) = events.next_if(|(at, _)| **at == k) {
+            for (lane, &start) in g.starts.iter().enumerate() {
+                if let (Some(&j0), Some(&j1)) = (jump.get(start), jump.get(start.wrapping_add(1))) {
+                    c[lane] += j0;
+                    c[LANES + lane] += j1;
+                }
+            }
+        }
+        let mut next = [0.0; 2 * LANES];
+        for l in 0..LANES {
+            let (x0, x1) = (x[l], x[LANES + l]);
+            next[l] = (p00[l] * x0 + p01[l] * x1) + c[l];
+            next[LANES + l] = (p10[l] * x0 + p11[l] * x1) + c[LANES + l];
+        }
+        x = next;
+        rows.push(x);
+        w_prev = wk;
+    }
+    rows
+}
+
+/// `out[k] += Σ_{j < LEN} coef[j] · rows[k][OFF + j]`.
+fn accumulate_rows<const OFF: usize, const LEN: usize>(
+    out: &mut [f64],
+    rows: &[[f64; 2 * LANES]],
+    coef: &[f64; 2 * LANES],
+) {
+    for (y, r) in out.iter_mut().zip(rows) {
+        let mut s = 0.0;
+        for j in 0..LEN {
+            s += coef[OFF + j] * r[OFF + j];
+        }
+        *y += s;
     }
 }
 
