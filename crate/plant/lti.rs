@@ -122,6 +122,39 @@ impl Lti {
         Ok(BlockMaps { phi, gamma })
     }
 
+    /// The block's augmented generator M = [[A, E], [0, S]] (see the module docs), balanced,
+    /// for [`Generator::apply`].
+    fn generator(&self, (start, m): (usize, usize), q: usize) -> Generator {
+        let size = m + q;
+        let mut a = vec![0.0; size * size];
+        for i in 0..m {
+            for j in 0..m {
+                a[i * size + j] = self.a[(start + i, start + j)];
+            }
+            for k in 0..q {
+                a[i * size + m + k] = self.e[(start + i, k)];
+            }
+        }
+        for k in 0..q.saturating_sub(1) {
+            a[(m + k) * size + m + k + 1] = 1.0;
+        }
+        let d = balance(&mut a, size);
+        let norm = (0..size)
+            .map(|i| {
+                a[i * size..(i + 1) * size]
+                    .iter()
+                    .map(|v| v.abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0_f64, f64::max);
+        Generator {
+            size,
+            b: a,
+            d,
+            norm,
+        }
+    }
+
     /// The state jump a knot causes: a jump Jⱼ in the command's j-th derivative is a Dirac
     /// Jⱼδ in derivative j + 1, which E turns into the state jump E[:, j+1]·Jⱼ. A Dirac's
     /// derivative (E reading derivative ≥ j + 2 of a jump in j) is rejected.
@@ -202,6 +235,9 @@ impl Lti {
             .map(|&b| self.block_maps(b, q, sample_period))
             .collect::<Result<_>>()?;
         let columns = self.input_columns();
+        let generators: Vec<Generator> =
+            self.blocks.iter().map(|&b| self.generator(b, q)).collect();
+        let mut scratch = Scratch::default();
         let knots = command.knots();
 
         // Pass 1: w[k·q + kk] = the command's kk-th derivative at sample k; the knots' state
@@ -232,6 +268,27 @@ impl Lti {
                 } else {
                     if !jumped {
                         imp.iter_mut().for_each(|v| *v = 0.0);
+                    }
+                    // Usually e^{Mδ}·(impulse, jumps) directly (a few matrix–vector products);
+                    // the one-step maps only when δ·‖M‖ is so large that the vector series
+                    // would need many substeps.
+                    if generators.iter().all(|g| g.substeps(delta).is_some()) {
+                        event_at.push(k);
+                        let base = event_jump.len();
+                        event_jump.resize(base + n, 0.0);
+                        let jump = &mut event_jump[base..];
+                        for (g, &(start, m)) in generators.iter().zip(&self.blocks) {
+                            scratch.input(&imp[start..start + m], &knot.jumps[..q]);
+                            g.apply(delta, &mut scratch.z, &mut scratch.work);
+                            jump[start..start + m].copy_from_slice(&scratch.z[..m]);
+                        }
+                        taylor_shift(&anchor, knot.time - anchor_time, &mut shifted);
+                        for ((a, s), j) in anchor.iter_mut().zip(&shifted).zip(&knot.jumps) {
+                            *a = s + j;
+                        }
+                        anchor_time = knot.time;
+                        next += 1;
+                        continue;
                     }
                     let key = delta.to_bits();
                     if !cache.contains_key(&key) {
@@ -555,19 +612,93 @@ fn accumulate_rows<const OFF: usize, const LEN: usize>(
     }
 }
 
-/// exp(M) of a small square matrix: scaling and squaring of a Taylor series. The maps are
-/// recomputed for every knot between samples (a shaped command has hundreds), where nalgebra's
-/// Padé `exp` — with its norm estimates, allocations and LU solve — dominated a page frame.
-/// After scaling ‖M/2ˢ‖∞ ≤ ½, the series is summed until a term is below 10⁻¹⁸ of the sum (at
-/// most 30 terms; the remainder is then below 2⁻³⁰/30!), then squared s times. The tests of
-/// the simulation (closed-form step and ramp responses, Singhose 2009 eq. 11) check the result.
-fn expm(m: &DMatrix<f64>) -> DMatrix<f64> {
-    let n = m.nrows();
-    // Row-major flat copy, balanced first: B = D⁻¹MD with D diagonal powers of two (exact),
-    // chosen so each state's row and column weigh alike (Parlett–Reinsch). A mode block
-    // [[0, h], [−ω²h, −2ζωh]] has ∞-norm ω²h but balances to about ωh, which saves the
-    // squarings; exp(M) = D·exp(B)·D⁻¹.
-    let mut a: Vec<f64> = (0..n * n).map(|k| m[(k / n, k % n)]).collect();
+/// A block's augmented generator, balanced: `b` = D⁻¹MD (row-major, `size` × `size`),
+/// `d` = D's diagonal (powers of two), `norm` = ‖B‖∞.
+#[derive(Debug, Clone)]
+struct Generator {
+    size: usize,
+    b: Vec<f64>,
+    d: Vec<f64>,
+    norm: f64,
+}
+
+/// Buffers reused across knots.
+#[derive(Debug, Default)]
+struct Scratch {
+    z: Vec<f64>,
+    work: Vec<f64>,
+}
+
+impl Scratch {
+    /// `z` = (state, jumps) as one vector.
+    fn input(&mut self, state: &[f64], jumps: &[f64]) {
+        self.z.clear();
+        self.z.extend_from_slice(state);
+        self.z.extend_from_slice(jumps);
+    }
+}
+
+/// Substeps beyond which a knot's exponential is formed as a matrix instead.
+const MAX_SUBSTEPS: usize = 8;
+
+impl Generator {
+    /// How many substeps of length δ/s keep ‖B‖·δ/s ≤ ½, or `None` beyond [`MAX_SUBSTEPS`]
+    /// (or for a non-finite δ·‖B‖).
+    fn substeps(&self, delta: f64) -> Option<usize> {
+        let x = self.norm * delta.abs() / 0.5;
+        if !x.is_finite() {
+            return None;
+        }
+        let s = x.ceil().max(1.0);
+        (s <= MAX_SUBSTEPS as f64).then_some(s as usize)
+    }
+
+    /// z ← e^{Mδ} z: on the balanced generator, e^{Bh} applied s times (h = δ/s, ‖Bh‖ ≤ ½)
+    /// by its Taylor series summed until a term is below 10⁻¹⁸ of the sum (at most 30
+    /// terms), as [`expm`] sums its series, but on one vector — a few matrix–vector products
+    /// instead of matrix products. `z.len()` must be `size`.
+    fn apply(&self, delta: f64, z: &mut [f64], work: &mut Vec<f64>) {
+        let n = self.size;
+        let Some(steps) = self.substeps(delta) else {
+            return;
+        };
+        let h = delta / steps as f64;
+        work.clear();
+        work.resize(2 * n, 0.0);
+        let (term, next) = work.split_at_mut(n);
+        for (v, d) in z.iter_mut().zip(&self.d) {
+            *v /= d;
+        }
+        for _ in 0..steps {
+            term.copy_from_slice(z);
+            for k in 1..=30 {
+                let c = h / k as f64;
+                for (i, o) in next.iter_mut().enumerate() {
+                    let row = &self.b[i * n..(i + 1) * n];
+                    *o = c * row.iter().zip(term.iter()).map(|(a, t)| a * t).sum::<f64>();
+                }
+                term.copy_from_slice(next);
+                let (mut biggest, mut size) = (0.0_f64, 0.0_f64);
+                for (s, t) in z.iter_mut().zip(term.iter()) {
+                    *s += t;
+                    biggest = biggest.max(t.abs());
+                    size = size.max(s.abs());
+                }
+                if biggest <= 1e-18 * size {
+                    break;
+                }
+            }
+        }
+        for (v, d) in z.iter_mut().zip(&self.d) {
+            *v *= d;
+        }
+    }
+}
+
+/// Balances the row-major `n` × `n` matrix `a` in place: B = D⁻¹AD with D diagonal powers of
+/// two (exact), chosen so each state's row and column weigh alike (Parlett–Reinsch). Returns
+/// D's diagonal.
+fn balance(a: &mut [f64], n: usize) -> Vec<f64> {
     let mut d = vec![1.0_f64; n];
     for _ in 0..8 {
         let mut changed = false;
@@ -600,6 +731,23 @@ fn expm(m: &DMatrix<f64>) -> DMatrix<f64> {
             break;
         }
     }
+    d
+}
+
+/// exp(M) of a small square matrix: scaling and squaring of a Taylor series. The maps are
+/// recomputed for every knot between samples (a shaped command has hundreds), where nalgebra's
+/// Padé `exp` — with its norm estimates, allocations and LU solve — dominated a page frame.
+/// After scaling ‖M/2ˢ‖∞ ≤ ½, the series is summed until a term is below 10⁻¹⁸ of the sum (at
+/// most 30 terms; the remainder is then below 2⁻³⁰/30!), then squared s times. The tests of
+/// the simulation (closed-form step and ramp responses, Singhose 2009 eq. 11) check the result.
+fn expm(m: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = m.nrows();
+    // Row-major flat copy, balanced first: B = D⁻¹MD with D diagonal powers of two (exact),
+    // chosen so each state's row and column weigh alike (Parlett–Reinsch). A mode block
+    // [[0, h], [−ω²h, −2ζωh]] has ∞-norm ω²h but balances to about ωh, which saves the
+    // squarings; exp(M) = D·exp(B)·D⁻¹.
+    let mut a: Vec<f64> = (0..n * n).map(|k| m[(k / n, k % n)]).collect();
+    let d = balance(&mut a, n);
     let norm = (0..n)
         .map(|i| (0..n).map(|j| a[i * n + j].abs()).sum::<f64>())
         .fold(0.0_f64, f64::max);
@@ -698,5 +846,44 @@ mod expm_tests {
         let (ours, pade) = (expm(&big), big.exp());
         let rel = (&ours - &pade).abs().max() / pade.abs().max();
         assert!(rel < 1e-12, "{rel}");
+    }
+
+    /// A knot's e^{Mδ}·z from the vector series (the common path of `respond`) against the
+    /// matrix exponential `block_maps` forms, for a lightly damped 3 Hz mode driven through
+    /// ω²u with a cubic command (q = 4), over sub-sample offsets from 10⁻⁵ s to the largest
+    /// one the vector path takes; beyond it `substeps` refuses.
+    #[test]
+    fn vector_exponential_matches_the_matrix_one() {
+        let w = 2.0 * std::f64::consts::PI * 3.0;
+        let lti = Lti {
+            a: DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -w * w, -2.0 * 0.05 * w]),
+            e: DMatrix::from_row_slice(2, 4, &[0.0, 0.0, 0.0, 0.0, w * w, 0.0, 0.0, 0.0]),
+            c: DMatrix::zeros(OUTPUTS, 2),
+            d: DMatrix::zeros(OUTPUTS, 4),
+            blocks: vec![(0, 2)],
+        };
+        let g = lti.generator((0, 2), 4);
+        let z0 = [0.3, -1.7, 0.9, 2.5, -4.0, 11.0];
+        let limit = MAX_SUBSTEPS as f64 * 0.5 / g.norm;
+        for delta in [1e-5, 1e-3, 0.01, 0.05, 0.9 * limit] {
+            assert!(g.substeps(delta).is_some(), "{delta}");
+            let mut z = z0.to_vec();
+            g.apply(delta, &mut z, &mut Vec::new());
+            let maps = lti.block_maps((0, 2), 4, delta).unwrap();
+            for i in 0..2 {
+                let want: f64 = (0..2).map(|j| maps.phi[i * 2 + j] * z0[j]).sum::<f64>()
+                    + (0..4)
+                        .map(|k| maps.gamma[i * 4 + k] * z0[2 + k])
+                        .sum::<f64>();
+                let scale = want.abs().max(1.0);
+                assert!(
+                    (z[i] - want).abs() <= 1e-13 * scale,
+                    "δ {delta}: {} vs {want}",
+                    z[i]
+                );
+            }
+        }
+        assert_eq!(g.substeps(1.1 * limit), None);
+        assert_eq!(g.substeps(f64::INFINITY), None);
     }
 }
