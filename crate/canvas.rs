@@ -1,25 +1,78 @@
 //! The page's drawing backend: plotters-canvas's [`CanvasBackend`] with text measured by the
-//! canvas itself.
+//! canvas itself and the 2-D context's state set only when it changes.
 //!
 //! plotters measures text on the web by appending a `<span>` to the document and reading its
 //! size, which forces a layout of the whole page for every tick label — about a fifth of a
-//! playground frame. [`Canvas`] delegates all drawing to `CanvasBackend` and answers
-//! [`DrawingBackend::estimate_text_size`] with the 2-D context's `measureText` in the same font
-//! string `CanvasBackend::draw_text` sets, so the size is that of the text as it will be drawn,
-//! and nothing touches the DOM. Compiled only for wasm32.
+//! playground frame. [`Canvas`] answers [`DrawingBackend::estimate_text_size`] with the 2-D
+//! context's `measureText` in the same font string `CanvasBackend::draw_text` sets, so the
+//! size is that of the text as it will be drawn, and nothing touches the DOM.
+//!
+//! Lines, paths, rectangles and text — hundreds per chart (grid lines, tick labels) — are drawn
+//! here as `CanvasBackend` draws them, except that the stroke style, line width, fill style,
+//! font and text alignment are written to the context only when they differ from what was last
+//! written: each write formats a CSS string that the browser then parses. Bitmaps (the
+//! sensitivity map) are written with one `putImageData`. Everything else is delegated to
+//! `CanvasBackend`, after which the remembered state is forgotten (it may have changed it).
+//! Compiled only for wasm32.
 
 use plotters::prelude::DrawingBackend;
+use plotters_backend::text_anchor::{HPos, VPos};
 use plotters_backend::{
-    BackendColor, BackendCoord, BackendStyle, BackendTextStyle, DrawingErrorKind,
+    BackendColor, BackendCoord, BackendStyle, BackendTextStyle, DrawingErrorKind, FontTransform,
 };
 use plotters_canvas::CanvasBackend;
-use wasm_bindgen::JsCast;
-use web_sys::{CanvasRenderingContext2d, HtmlCanvasElement};
+use std::cell::RefCell;
+use wasm_bindgen::{Clamped, JsCast};
+use web_sys::{CanvasRenderingContext2d, HtmlCanvasElement, ImageData};
+
+/// What was last written to the context (`None`: unknown).
+#[derive(Debug, Default)]
+struct ContextState {
+    stroke: Option<(String, u32)>,
+    fill: Option<String>,
+    font: Option<String>,
+    align: Option<(&'static str, &'static str)>,
+}
 
 /// A canvas backend whose text measurement does not force a page layout (module docs).
 pub(crate) struct Canvas {
     inner: CanvasBackend,
     context: CanvasRenderingContext2d,
+    state: RefCell<ContextState>,
+}
+
+/// plotters-canvas's colour string.
+fn css_color(color: BackendColor) -> String {
+    let (r, g, b) = color.rgb;
+    format!("rgba({},{},{},{})", r, g, b, color.alpha)
+}
+
+/// The font string `CanvasBackend::draw_text` sets.
+fn css_font<S: BackendTextStyle>(style: &S) -> String {
+    format!(
+        "{} {}px {}",
+        style.style().as_str(),
+        style.size(),
+        style.family().as_str(),
+    )
+}
+
+/// Moves a horizontal or vertical line to the half pixel, as plotters-canvas does, so it is
+/// not blurred over two pixels.
+fn fine_lines(from: BackendCoord, to: BackendCoord) -> ((f64, f64), (f64, f64)) {
+    let (mut a, mut b) = (
+        (f64::from(from.0), f64::from(from.1)),
+        (f64::from(to.0), f64::from(to.1)),
+    );
+    if a.0 == b.0 {
+        a.0 -= 0.5;
+        b.0 -= 0.5;
+    }
+    if a.1 == b.1 {
+        a.1 -= 0.5;
+        b.1 -= 0.5;
+    }
+    (a, b)
 }
 
 impl Canvas {
@@ -34,7 +87,44 @@ impl Canvas {
         Some(Canvas {
             inner: CanvasBackend::with_canvas_object(canvas)?,
             context,
+            state: RefCell::default(),
         })
+    }
+
+    /// Sets the stroke colour and width unless they are already set.
+    fn line_style<S: BackendStyle>(&self, style: &S) {
+        let want = (css_color(style.color()), style.stroke_width());
+        let mut st = self.state.borrow_mut();
+        if st.stroke.as_ref() != Some(&want) {
+            self.context.set_stroke_style_str(&want.0);
+            self.context.set_line_width(f64::from(want.1));
+            st.stroke = Some(want);
+        }
+    }
+
+    /// Sets the fill colour unless it is already set.
+    fn fill_style(&self, color: BackendColor) {
+        let want = css_color(color);
+        let mut st = self.state.borrow_mut();
+        if st.fill.as_ref() != Some(&want) {
+            self.context.set_fill_style_str(&want);
+            st.fill = Some(want);
+        }
+    }
+
+    /// Sets the font unless it is already set.
+    fn font<S: BackendTextStyle>(&self, style: &S) {
+        let want = css_font(style);
+        let mut st = self.state.borrow_mut();
+        if st.font.as_ref() != Some(&want) {
+            self.context.set_font(&want);
+            st.font = Some(want);
+        }
+    }
+
+    /// After a call delegated to `CanvasBackend`, which may have set any of the state.
+    fn forget(&self) {
+        *self.state.borrow_mut() = ContextState::default();
     }
 }
 
@@ -56,6 +146,7 @@ impl DrawingBackend for Canvas {
     }
 
     fn draw_pixel(&mut self, point: BackendCoord, color: BackendColor) -> Result<(), Failure> {
+        self.forget();
         self.inner.draw_pixel(point, color)
     }
 
@@ -65,7 +156,16 @@ impl DrawingBackend for Canvas {
         to: BackendCoord,
         style: &S,
     ) -> Result<(), Failure> {
-        self.inner.draw_line(from, to, style)
+        if style.color().alpha == 0.0 {
+            return Ok(());
+        }
+        let (a, b) = fine_lines(from, to);
+        self.line_style(style);
+        self.context.begin_path();
+        self.context.move_to(a.0, a.1);
+        self.context.line_to(b.0, b.1);
+        self.context.stroke();
+        Ok(())
     }
 
     fn draw_rect<S: BackendStyle>(
@@ -75,7 +175,22 @@ impl DrawingBackend for Canvas {
         style: &S,
         fill: bool,
     ) -> Result<(), Failure> {
-        self.inner.draw_rect(upper_left, bottom_right, style, fill)
+        if style.color().alpha == 0.0 {
+            return Ok(());
+        }
+        let (x, y) = (f64::from(upper_left.0), f64::from(upper_left.1));
+        let (w, h) = (
+            f64::from(bottom_right.0 - upper_left.0),
+            f64::from(bottom_right.1 - upper_left.1),
+        );
+        if fill {
+            self.fill_style(style.color());
+            self.context.fill_rect(x, y, w, h);
+        } else {
+            self.line_style(style);
+            self.context.stroke_rect(x, y, w, h);
+        }
+        Ok(())
     }
 
     fn draw_path<S: BackendStyle, I: IntoIterator<Item = BackendCoord>>(
@@ -83,7 +198,20 @@ impl DrawingBackend for Canvas {
         path: I,
         style: &S,
     ) -> Result<(), Failure> {
-        self.inner.draw_path(path, style)
+        if style.color().alpha == 0.0 {
+            return Ok(());
+        }
+        let mut path = path.into_iter();
+        self.context.begin_path();
+        if let Some(start) = path.next() {
+            self.line_style(style);
+            self.context.move_to(f64::from(start.0), f64::from(start.1));
+            for next in path {
+                self.context.line_to(f64::from(next.0), f64::from(next.1));
+            }
+        }
+        self.context.stroke();
+        Ok(())
     }
 
     fn draw_circle<S: BackendStyle>(
@@ -93,6 +221,7 @@ impl DrawingBackend for Canvas {
         style: &S,
         fill: bool,
     ) -> Result<(), Failure> {
+        self.forget();
         self.inner.draw_circle(center, radius, style, fill)
     }
 
@@ -101,6 +230,7 @@ impl DrawingBackend for Canvas {
         vert: I,
         style: &S,
     ) -> Result<(), Failure> {
+        self.forget();
         self.inner.fill_polygon(vert, style)
     }
 
@@ -110,7 +240,52 @@ impl DrawingBackend for Canvas {
         style: &S,
         pos: BackendCoord,
     ) -> Result<(), Failure> {
-        self.inner.draw_text(text, style, pos)
+        let color = style.color();
+        if color.alpha == 0.0 {
+            return Ok(());
+        }
+        let degrees = match style.transform() {
+            FontTransform::None => 0.0,
+            FontTransform::Rotate90 => 90.0,
+            FontTransform::Rotate180 => 180.0,
+            FontTransform::Rotate270 => 270.0,
+        };
+        if degrees != 0.0 {
+            // Rotated text (axis titles, a few per chart) goes through CanvasBackend.
+            self.forget();
+            return self.inner.draw_text(text, style, pos);
+        }
+        let baseline = match style.anchor().v_pos {
+            VPos::Top => "top",
+            VPos::Center => "middle",
+            VPos::Bottom => "bottom",
+        };
+        let align = match style.anchor().h_pos {
+            HPos::Left => "start",
+            HPos::Right => "end",
+            HPos::Center => "center",
+        };
+        {
+            let mut st = self.state.borrow_mut();
+            if st.align != Some((align, baseline)) {
+                self.context.set_text_baseline(baseline);
+                self.context.set_text_align(align);
+                st.align = Some((align, baseline));
+            }
+        }
+        self.fill_style(color);
+        self.font(style);
+        match self
+            .context
+            .fill_text(text, f64::from(pos.0), f64::from(pos.1))
+        {
+            Ok(()) => Ok(()),
+            // Never seen; CanvasBackend reports the error in its own type.
+            Err(_) => {
+                self.forget();
+                self.inner.draw_text(text, style, pos)
+            }
+        }
     }
 
     fn estimate_text_size<S: BackendTextStyle>(
@@ -118,13 +293,8 @@ impl DrawingBackend for Canvas {
         text: &str,
         style: &S,
     ) -> Result<(u32, u32), Failure> {
-        // The font string CanvasBackend::draw_text sets before fill_text.
-        self.context.set_font(&format!(
-            "{} {}px {}",
-            style.style().as_str(),
-            style.size(),
-            style.family().as_str(),
-        ));
+        // The font string draw_text sets before fill_text.
+        self.font(style);
         match self.context.measure_text(text) {
             Ok(m) => {
                 let height = m.font_bounding_box_ascent() + m.font_bounding_box_descent();
@@ -140,12 +310,33 @@ impl DrawingBackend for Canvas {
         }
     }
 
+    /// One `putImageData` of the RGB bitmap (plotters' pixel-by-pixel default would be a
+    /// `fillRect` per pixel); falls back to the default if the context refuses it.
     fn blit_bitmap(
         &mut self,
         pos: BackendCoord,
-        size: (u32, u32),
+        (w, h): (u32, u32),
         src: &[u8],
     ) -> Result<(), Failure> {
-        self.inner.blit_bitmap(pos, size, src)
+        let pixels = w as usize * h as usize;
+        if w == 0 || h == 0 || src.len() < 3 * pixels {
+            self.forget();
+            return self.inner.blit_bitmap(pos, (w, h), src);
+        }
+        let mut rgba = Vec::with_capacity(4 * pixels);
+        for px in src.chunks_exact(3).take(pixels) {
+            rgba.extend_from_slice(&[px[0], px[1], px[2], 255]);
+        }
+        let image = ImageData::new_with_u8_clamped_array_and_sh(Clamped(&rgba), w, h);
+        match image.and_then(|img| {
+            self.context
+                .put_image_data(&img, f64::from(pos.0), f64::from(pos.1))
+        }) {
+            Ok(()) => Ok(()),
+            Err(_) => {
+                self.forget();
+                self.inner.blit_bitmap(pos, (w, h), src)
+            }
+        }
     }
 }

@@ -491,33 +491,47 @@ fn move_metrics(
 thread_local! {
     /// The last robustness table and its key (mode 1's frequency and damping, Vtol, as bits):
     /// designing every family is the slowest part of a frame and only these inputs change it.
-    static ROBUSTNESS: RefCell<Option<([u64; 3], Vec<RobustnessRow>)>> = const { RefCell::new(None) };
+    static ROBUSTNESS: RefCell<Option<([u64; 2], Vec<RobustnessRow>)>> = const { RefCell::new(None) };
 }
 
 fn robustness_rows(mode: &Mode, vtol: f64) -> Result<Vec<RobustnessRow>, Error> {
-    let key = [
-        mode.frequency_hz().to_bits(),
-        mode.damping().to_bits(),
-        vtol.to_bits(),
-    ];
-    if let Some(rows) = ROBUSTNESS.with_borrow(|c| {
+    // Every parameterless family designs a shaper whose impulse times scale with the mode's
+    // period (at a fixed damping ratio), so the table's durations in periods and its
+    // insensitivities (fractions of the frequency, and damping widths) depend on ζ and Vtol
+    // only. The table is designed once per (ζ, Vtol) for a 1 Hz mode and the seconds are
+    // rescaled, so editing a frequency does not redesign a dozen shapers every frame.
+    let key = [mode.damping().to_bits(), vtol.to_bits()];
+    let cached = ROBUSTNESS.with_borrow(|c| {
         c.as_ref()
             .filter(|(k, _)| *k == key)
             .map(|(_, r)| r.clone())
-    }) {
-        return Ok(rows);
-    }
-    // Families that cannot be designed for this mode (e.g. EI beyond its damping range) are
-    // left out of the background rather than failing the frame.
-    let rows: Vec<RobustnessRow> = crate::robustness::parameterless_specs()
+    });
+    let rows = match cached {
+        Some(rows) => rows,
+        None => {
+            let unit = Mode::new(1.0, mode.damping())?;
+            // Families that cannot be designed for this mode (e.g. EI beyond its damping
+            // range) are left out of the background rather than failing the frame.
+            let rows: Vec<RobustnessRow> = crate::robustness::parameterless_specs()
+                .into_iter()
+                .filter_map(|spec| {
+                    crate::robustness::robustness_table(std::slice::from_ref(&spec), &unit, vtol)
+                        .ok()
+                })
+                .flatten()
+                .collect();
+            ROBUSTNESS.with_borrow_mut(|c| *c = Some((key, rows.clone())));
+            rows
+        }
+    };
+    let period = mode.damped_period_s();
+    Ok(rows
         .into_iter()
-        .filter_map(|spec| {
-            crate::robustness::robustness_table(std::slice::from_ref(&spec), mode, vtol).ok()
+        .map(|r| RobustnessRow {
+            duration_s: r.duration_periods * period,
+            ..r
         })
-        .flatten()
-        .collect();
-    ROBUSTNESS.with_borrow_mut(|c| *c = Some((key, rows.clone())));
-    Ok(rows)
+        .collect())
 }
 
 /// `renderPlayground(state, canvases)`: everything one frame of the page needs, in one call.
@@ -804,8 +818,15 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
             .iter()
             .map(|m| (m.frequency_hz(), m.damping()))
             .collect();
-        chart::draw_sensitivity_map(&b.into_drawing_area(), map, Some(view.vtol), &marks, &style)
-            .map_err(js_error)?;
+        chart::draw_sensitivity_map_with(
+            &b.into_drawing_area(),
+            map,
+            Some(view.vtol),
+            &marks,
+            &style,
+            chart::MapCells::Bitmap,
+        )
+        .map_err(js_error)?;
     }
     let traj_series: Vec<(&str, &Trajectory)> = trajectories
         .iter()

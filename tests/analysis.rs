@@ -314,6 +314,35 @@ fn zv_damping_insensitivity_edges_match_closed_form() {
     );
 }
 
+/// The page designs its robustness background once per (ζ, Vtol) at 1 Hz and rescales the
+/// seconds (crate/wasm.rs `robustness_rows`): every parameterless family's durations in
+/// periods and insensitivities must then not depend on the mode's frequency. Checked for
+/// frequencies two decades apart, at a damped mode, against the table designed at each.
+#[wasm_bindgen_test(unsupported = test)]
+fn robustness_table_is_frequency_invariant_at_fixed_damping() {
+    let specs = parameterless_specs();
+    let at = |f: f64| robustness_table(&specs, &Mode::new(f, 0.05).unwrap(), 0.05).unwrap();
+    let unit = at(1.0);
+    for f in [0.37, 45.0] {
+        let rows = at(f);
+        let period = Mode::new(f, 0.05).unwrap().damped_period_s();
+        assert_eq!(rows.len(), unit.len());
+        for (r, u) in rows.iter().zip(&unit) {
+            assert_eq!((&r.spec, r.impulses), (&u.spec, u.impulses), "{}", r.title);
+            let what = format!("{} at {f} Hz", r.title);
+            close(r.duration_periods, u.duration_periods, 1e-6, &what);
+            close(r.duration_s, u.duration_periods * period, 1e-6, &what);
+            close(r.insensitivity, u.insensitivity, 1e-6, &what);
+            close(
+                r.damping_insensitivity,
+                u.damping_insensitivity,
+                1e-6,
+                &what,
+            );
+        }
+    }
+}
+
 /// Singhose 2009 Fig. 11 for the zero-derivative shapers at ζ = 0: ZV-Dⁿ lasts (n+1)/2 periods
 /// and, since it is ZV convolved n+1 times, V = |cos(πf/(2f_m))|ⁿ⁺¹, so
 /// I(Vtol) = (4/π)·asin(Vtol^{1/(n+1)}): 0.0637 for ZV and 0.2871 for ZVD, which the paper's

@@ -239,3 +239,40 @@ fn damping_chart_has_curves_vtol_and_marker() {
     let upper = out.to_uppercase();
     assert!(upper.contains("#0072B2") && upper.contains("#D55E00"));
 }
+
+/// The page's bitmap cells (`MapCells::Bitmap`): each pixel takes the colour of the cell whose
+/// backend edges enclose it — the pixels `MapCells::Rectangles` fills — and pixels beyond the
+/// last edge stay white. Levels: V/top quantised to 64 steps, coloured at their midpoints.
+#[test]
+fn map_bitmap_colours_each_pixel_by_its_cell() {
+    use input_shaping::chart::map::raster_cells;
+    let map = SensitivityMap {
+        frequency_hz: vec![1.0, 2.0, 3.0],
+        damping: vec![0.0, 0.1],
+        // Row k = 0 (ζ = 0, drawn at the bottom), then row k = 1.
+        vibration: vec![0.0, 0.5, 1.0, 0.25, f64::NAN, 0.75],
+    };
+    let (xe, ye) = ([0, 10, 20, 30], [20, 10, 0]);
+    let b = raster_cells(&map, 1.0, (0, 35), (0, 20), &xe, &ye);
+    assert_eq!(
+        (b.origin, b.size, b.rgb.len()),
+        ((0, 0), (35, 20), 35 * 20 * 3)
+    );
+    let px = |x: usize, y: usize| {
+        let i = 3 * (y * 35 + x);
+        format!("#{:02X}{:02X}{:02X}", b.rgb[i], b.rgb[i + 1], b.rgb[i + 2])
+    };
+    let level = |v: f64| {
+        let l = ((v * COLOR_LEVELS as f64) as usize).min(COLOR_LEVELS - 1);
+        hex(scale_color((l as f64 + 0.5) / COLOR_LEVELS as f64))
+    };
+    // Bottom row (y 10 … 19) is ζ = 0; the top row (y 0 … 9) is ζ = 0.1.
+    assert_eq!(px(0, 19), level(0.0));
+    assert_eq!(px(15, 10), level(0.5));
+    assert_eq!(px(29, 12), level(1.0));
+    assert_eq!(px(9, 0), level(0.25));
+    assert_eq!(px(10, 9), level(1.0), "NaN is drawn as the top level");
+    assert_eq!(px(25, 5), level(0.75));
+    assert_eq!(px(30, 5), "#FFFFFF", "beyond the last edge");
+    assert_eq!(px(34, 19), "#FFFFFF");
+}

@@ -5,9 +5,7 @@
 //! velocity and acceleration are impulses and do not show on a sampled axis (they read as 0);
 //! the impulse chart shows what the shaper makes of them.
 
-use super::{
-    decimate, draw_legend, padded_range, render_error, swatch, ChartStyle, UNSHAPED_COLOR,
-};
+use super::{decimate, padded_range, render_error, swatch, ChartStyle, Legend, UNSHAPED_COLOR};
 use crate::error::Result;
 use crate::simulate::Trajectory;
 use plotters::coord::Shift;
@@ -83,6 +81,7 @@ pub fn draw_command<DB: DrawingBackend>(
             mesh.x_desc("time (s)");
         }
         mesh.draw().map_err(render_error)?;
+        let mut keys = Legend::default();
         for (label, traj, color) in &all {
             let width = if *label == "command" { 1.5 } else { 2.0 };
             chart
@@ -90,12 +89,11 @@ pub fn draw_command<DB: DrawingBackend>(
                     decimate(&traj.time, pick(traj), buckets),
                     color.stroke_width(style.px(width)),
                 ))
-                .map_err(render_error)?
-                .label(label.to_string())
-                .legend(swatch(*color, style));
+                .map_err(render_error)?;
+            keys.push(*label, swatch(*color, style));
         }
         if index == 0 {
-            draw_legend(&mut chart, SeriesLabelPosition::LowerRight, style)?;
+            keys.draw_compact(&chart, SeriesLabelPosition::LowerRight, style)?;
         }
     }
     area.present().map_err(render_error)?;

@@ -1,7 +1,7 @@
 //! The damping sensitivity chart: residual vibration V (in %) against the plant's damping ratio
 //! at a fixed frequency, with the tolerable level Vtol and the modelled damping marked.
 
-use super::{render_error, ChartStyle};
+use super::{render_error, ChartStyle, Key, Legend};
 use crate::error::Result;
 use crate::vibration::DampingSensitivityCurve;
 use plotters::coord::Shift;
@@ -55,6 +55,7 @@ pub fn draw_damping_sensitivity<DB: DrawingBackend>(
             ))
             .map_err(render_error)?;
     }
+    let mut keys = Legend::default();
     if let Some(vtol) = vtol {
         let red = RGBColor(200, 30, 30);
         chart
@@ -62,9 +63,14 @@ pub fn draw_damping_sensitivity<DB: DrawingBackend>(
                 [(z_lo, vtol * 100.0), (z_hi, vtol * 100.0)],
                 red.stroke_width(style.px(1.0)),
             ))
-            .map_err(render_error)?
-            .label(format!("Vtol {:.3} %", vtol * 100.0))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], red.stroke_width(2)));
+            .map_err(render_error)?;
+        keys.push(
+            format!("Vtol {:.3} %", vtol * 100.0),
+            Key::Line {
+                len: 16,
+                style: red.stroke_width(2),
+            },
+        );
     }
     for (k, (label, curve)) in curves.iter().enumerate() {
         let color = style.color(k);
@@ -83,20 +89,16 @@ pub fn draw_damping_sensitivity<DB: DrawingBackend>(
                     }),
                 color.stroke_width(style.px(2.0)),
             ))
-            .map_err(render_error)?
-            .label(label.to_string())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(3))
-            });
+            .map_err(render_error)?;
+        keys.push(
+            label.to_string(),
+            Key::Line {
+                len: 16,
+                style: color.stroke_width(3),
+            },
+        );
     }
-    chart
-        .configure_series_labels()
-        .label_font(("sans-serif", style.font(12.0)))
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(180, 180, 180))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(render_error)?;
+    keys.draw_default(&chart, SeriesLabelPosition::UpperRight, style)?;
     area.present().map_err(render_error)?;
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! The impulse-sequence chart: each impulse as a stem from 0 to its amplitude at its time.
 
-use super::{render_error, ChartStyle};
+use super::{render_error, ChartStyle, Key, Legend};
 use crate::error::Result;
 use crate::shaper::Shaper;
 use plotters::coord::Shift;
@@ -51,6 +51,7 @@ pub fn draw_impulses<DB: DrawingBackend>(
             BLACK.stroke_width(style.px(1.0)),
         ))
         .map_err(render_error)?;
+    let mut keys = Legend::default();
     let n = shapers.len().max(1) as f64;
     for (k, (label, shaper)) in shapers.iter().enumerate() {
         let color = style.color(k);
@@ -74,11 +75,14 @@ pub fn draw_impulses<DB: DrawingBackend>(
                     stroke,
                 )
             }))
-            .map_err(render_error)?
-            .label(label.to_string())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(3))
-            });
+            .map_err(render_error)?;
+        keys.push(
+            label.to_string(),
+            Key::Line {
+                len: 16,
+                style: color.stroke_width(3),
+            },
+        );
         let r = style.px(4.0);
         chart
             .draw_series(shaper.impulses().iter().map(|imp| {
@@ -91,14 +95,7 @@ pub fn draw_impulses<DB: DrawingBackend>(
             .map_err(render_error)?;
     }
     if shapers.len() > 1 {
-        chart
-            .configure_series_labels()
-            .label_font(("sans-serif", style.font(12.0)))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(render_error)?;
+        keys.draw_default(&chart, SeriesLabelPosition::UpperRight, style)?;
     }
     area.present().map_err(render_error)?;
     Ok(())

@@ -6,11 +6,13 @@
 //! rectangles rather than 80 000. The contour is traced by marching squares on the grid
 //! ([`contour_segments`]).
 
-use super::{render_error, ChartStyle};
+use super::{render_error, ChartStyle, Key, Legend};
 use crate::error::{Error, Result};
 use crate::vibration::SensitivityMap;
 use plotters::coord::Shift;
+use plotters::element::{Drawable, PointCollection};
 use plotters::prelude::*;
+use plotters_backend::DrawingErrorKind;
 
 /// Number of distinct colours of the heat map.
 pub const COLOR_LEVELS: usize = 64;
@@ -155,6 +157,96 @@ fn cell_edges(values: &[f64]) -> Vec<f64> {
     edges
 }
 
+/// An RGB bitmap (3 bytes per pixel, row-major) drawn with its top-left corner at `origin`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bitmap {
+    /// Top-left corner, in the drawing area's pixels.
+    pub origin: (i32, i32),
+    /// Width and height in pixels.
+    pub size: (u32, u32),
+    /// `size.0 × size.1` pixels, 3 bytes (r, g, b) each, row by row from the top.
+    pub rgb: Vec<u8>,
+}
+
+impl<'a> PointCollection<'a, (i32, i32)> for &'a Bitmap {
+    type Point = &'a (i32, i32);
+    type IntoIter = std::iter::Once<&'a (i32, i32)>;
+    fn point_iter(self) -> Self::IntoIter {
+        std::iter::once(&self.origin)
+    }
+}
+
+impl<DB: DrawingBackend> Drawable<DB> for Bitmap {
+    fn draw<I: Iterator<Item = (i32, i32)>>(
+        &self,
+        mut points: I,
+        backend: &mut DB,
+        _: (u32, u32),
+    ) -> std::result::Result<(), DrawingErrorKind<DB::ErrorType>> {
+        match points.next() {
+            Some(at) if self.rgb.len() == 3 * self.size.0 as usize * self.size.1 as usize => {
+                backend.blit_bitmap(at, self.size, &self.rgb)
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The map's cells as a bitmap of the plotting area `x` × `y` (backend pixel ranges, end
+/// excluded), origin at the area's top-left. `xe` are the backend x of the cell edges along
+/// frequency (increasing) and `ye` the backend y of the edges along damping (decreasing: ζ grows
+/// upwards). Pixel (px, py) takes the colour of the cell whose edges enclose it,
+/// `xe[j] ≤ px < xe[j + 1]` and `ye[k + 1] ≤ py < ye[k]` — the pixels the rectangles of
+/// [`MapCells::Rectangles`] cover; pixels outside every cell stay white.
+pub fn raster_cells(
+    map: &SensitivityMap,
+    top: f64,
+    x: (i32, i32),
+    y: (i32, i32),
+    xe: &[i32],
+    ye: &[i32],
+) -> Bitmap {
+    let (w, h) = ((x.1 - x.0).max(0) as usize, (y.1 - y.0).max(0) as usize);
+    let nf = map.frequency_hz.len();
+    let cell = |edges: &[i32], p: i32, rising: bool| -> Option<usize> {
+        (0..edges.len().saturating_sub(1)).find(|&j| {
+            let (a, b) = (edges[j], edges[j + 1]);
+            if rising {
+                a <= p && p < b
+            } else {
+                b <= p && p < a
+            }
+        })
+    };
+    let columns: Vec<Option<usize>> = (x.0..x.1).map(|p| cell(xe, p, true)).collect();
+    let mut rgb = vec![255; 3 * w * h];
+    let mut colors = vec![(0, 0, 0); nf];
+    let mut last_row = None;
+    for (py, line) in (y.0..y.1).zip(rgb.chunks_exact_mut(3 * w.max(1))) {
+        let Some(k) = cell(ye, py, false) else {
+            continue;
+        };
+        if last_row != Some(k) {
+            let row = map.vibration.get(k * nf..(k + 1) * nf).unwrap_or(&[]);
+            for (c, &v) in colors.iter_mut().zip(row) {
+                let RGBColor(r, g, b) = level_color(level(v, top));
+                *c = (r, g, b);
+            }
+            last_row = Some(k);
+        }
+        for (px, col) in line.chunks_exact_mut(3).zip(&columns) {
+            if let Some((r, g, b)) = col.and_then(|j| colors.get(j).copied()) {
+                px.copy_from_slice(&[r, g, b]);
+            }
+        }
+    }
+    Bitmap {
+        origin: (0, 0),
+        size: (w as u32, h as u32),
+        rgb,
+    }
+}
+
 /// Draws the heat map of `map` (x: frequency in Hz, y: damping ratio), the contour V = `vtol`
 /// (fraction) in white, a white cross at each mode `(frequency Hz, damping)` in `modes`, and a
 /// colour bar of V in % on the right. The colour scale runs from 0 to the largest V of the map
@@ -165,6 +257,29 @@ pub fn draw_sensitivity_map<DB: DrawingBackend>(
     vtol: Option<f64>,
     modes: &[(f64, f64)],
     style: &ChartStyle,
+) -> Result<()> {
+    draw_sensitivity_map_with(area, map, vtol, modes, style, MapCells::Rectangles)
+}
+
+/// How [`draw_sensitivity_map_with`] draws the map's cells.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MapCells {
+    /// One filled rectangle per run of equal colour in a row: vector output (SVG).
+    Rectangles,
+    /// One bitmap of the plotting area, blitted at once — the same cells, pixel for pixel, in
+    /// one backend call instead of thousands (the page's canvas backend writes it with
+    /// `putImageData`; a backend without a bitmap operation draws it pixel by pixel).
+    Bitmap,
+}
+
+/// [`draw_sensitivity_map`], choosing how the cells are drawn.
+pub fn draw_sensitivity_map_with<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    map: &SensitivityMap,
+    vtol: Option<f64>,
+    modes: &[(f64, f64)],
+    style: &ChartStyle,
+    cells: MapCells,
 ) -> Result<()> {
     check_map(map)?;
     area.fill(&WHITE).map_err(render_error)?;
@@ -202,26 +317,48 @@ pub fn draw_sensitivity_map<DB: DrawingBackend>(
         .draw()
         .map_err(render_error)?;
 
-    // Cells, with runs of equal colour along a row merged into one rectangle.
     let (fe, ze) = (cell_edges(f), cell_edges(z));
-    let mut cells = Vec::new();
-    for (k, row) in map.vibration.chunks_exact(f.len()).enumerate() {
-        let (y0, y1) = (ze[k], ze[k + 1]);
-        let mut start = 0;
-        while start < row.len() {
-            let lv = level(row[start], top);
-            let mut end = start + 1;
-            while end < row.len() && level(row[end], top) == lv {
-                end += 1;
+    match cells {
+        MapCells::Rectangles => {
+            // Runs of equal colour along a row merged into one rectangle.
+            let mut rects = Vec::new();
+            for (k, row) in map.vibration.chunks_exact(f.len()).enumerate() {
+                let (y0, y1) = (ze[k], ze[k + 1]);
+                let mut start = 0;
+                while start < row.len() {
+                    let lv = level(row[start], top);
+                    let mut end = start + 1;
+                    while end < row.len() && level(row[end], top) == lv {
+                        end += 1;
+                    }
+                    rects.push(Rectangle::new(
+                        [(fe[start], y0), (fe[end], y1)],
+                        level_color(lv).filled(),
+                    ));
+                    start = end;
+                }
             }
-            cells.push(Rectangle::new(
-                [(fe[start], y0), (fe[end], y1)],
-                level_color(lv).filled(),
-            ));
-            start = end;
+            chart.draw_series(rects).map_err(render_error)?;
+        }
+        MapCells::Bitmap => {
+            let (xr, yr) = chart.plotting_area().get_pixel_range();
+            let xe: Vec<i32> = fe
+                .iter()
+                .map(|&v| chart.backend_coord(&(v, z_lo)).0)
+                .collect();
+            let ye: Vec<i32> = ze
+                .iter()
+                .map(|&v| chart.backend_coord(&(f_lo, v)).1)
+                .collect();
+            let bitmap = raster_cells(map, top, (xr.start, xr.end), (yr.start, yr.end), &xe, &ye);
+            chart
+                .plotting_area()
+                .strip_coord_spec()
+                .draw(&bitmap)
+                .map_err(render_error)?;
         }
     }
-    chart.draw_series(cells).map_err(render_error)?;
+    let mut keys = Legend::default();
 
     if let Some(vtol) = vtol {
         let line = CONTOUR_COLOR.stroke_width(style.px(2.0));
@@ -231,9 +368,14 @@ pub fn draw_sensitivity_map<DB: DrawingBackend>(
                     .into_iter()
                     .map(|[a, b]| PathElement::new(vec![a, b], line)),
             )
-            .map_err(render_error)?
-            .label(format!("V = Vtol ({:.3} %)", vtol * 100.0))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], line));
+            .map_err(render_error)?;
+        keys.push(
+            format!("V = Vtol ({:.3} %)", vtol * 100.0),
+            Key::Line {
+                len: 16,
+                style: line,
+            },
+        );
     }
     let inside =
         |&&(mf, mz): &&(f64, f64)| (f_lo..=f_hi).contains(&mf) && (z_lo..=z_hi).contains(&mz);
@@ -246,14 +388,7 @@ pub fn draw_sensitivity_map<DB: DrawingBackend>(
         )
         .map_err(render_error)?;
     if vtol.is_some() {
-        chart
-            .configure_series_labels()
-            .label_font(("sans-serif", style.font(12.0)))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(render_error)?;
+        keys.draw_default(&chart, SeriesLabelPosition::UpperRight, style)?;
     }
 
     // Colour bar: the levels stacked from 0 to `top`, labelled in %.

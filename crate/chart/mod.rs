@@ -17,7 +17,7 @@ use plotters::prelude::*;
 pub use command::draw_command;
 pub use damping::draw_damping_sensitivity;
 pub use impulses::draw_impulses;
-pub use map::draw_sensitivity_map;
+pub use map::{draw_sensitivity_map, draw_sensitivity_map_with, MapCells};
 pub use measured::draw_measured_spectrum;
 pub use response::draw_response;
 pub use robustness::{draw_robustness, RobustnessMark};
@@ -168,35 +168,142 @@ pub(crate) fn decimate(x: &[f64], y: &[f64], buckets: usize) -> Vec<(f64, f64)> 
     out
 }
 
-/// Draws the series legend of a chart in the page's style.
-pub(crate) fn draw_legend<'a, DB, CT>(
-    chart: &mut ChartContext<'a, DB, CT>,
-    position: SeriesLabelPosition,
-    style: &ChartStyle,
-) -> crate::error::Result<()>
-where
-    DB: DrawingBackend + 'a,
-    CT: plotters::coord::CoordTranslate,
-{
-    chart
-        .configure_series_labels()
-        .label_font(("sans-serif", style.font(12.0)))
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(180, 180, 180))
-        .margin(style.px(6.0))
-        .legend_area_size(style.px(22.0))
-        .position(position)
-        .draw()
-        .map_err(render_error)
+/// What a legend entry shows before its label, drawn centred on the label's line.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Key {
+    /// A horizontal line `len` pixels long.
+    Line { len: i32, style: ShapeStyle },
+    /// A circle `dx` pixels right of the key area's left edge.
+    Dot {
+        dx: i32,
+        radius: i32,
+        style: ShapeStyle,
+    },
 }
 
-/// A legend swatch: a short thick line of `color`, scaled.
-pub(crate) fn swatch(
-    color: RGBColor,
-    style: &ChartStyle,
-) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
-    let (len, width) = (style.px(16.0) as i32, style.px(3.0));
-    move |(x, y)| PathElement::new(vec![(x, y), (x + len, y)], color.stroke_width(width))
+/// A swatch key: a short thick line of `color`, scaled.
+pub(crate) fn swatch(color: RGBColor, style: &ChartStyle) -> Key {
+    Key::Line {
+        len: style.px(16.0) as i32,
+        style: color.stroke_width(style.px(3.0)),
+    }
+}
+
+/// A chart's legend: labelled keys in a framed box in a corner of the plotting area.
+///
+/// Drawn here rather than by plotters' series labels, which measure every label through the
+/// font layer — on the web a `<span>` appended to the page and read back, a forced layout per
+/// label per frame. This measures through the drawing backend instead (the canvas backend
+/// asks the 2-D context's `measureText`; the SVG backend estimates), with plotters' layout:
+/// lines 1.25 font sizes apart, `margin` inside the frame, the keys in a column `key_area`
+/// wide, 5 px from the plotting area's edges.
+#[derive(Debug, Default)]
+pub(crate) struct Legend {
+    entries: Vec<(String, Key)>,
+}
+
+impl Legend {
+    /// Adds an entry.
+    pub(crate) fn push(&mut self, label: impl Into<String>, key: Key) {
+        self.entries.push((label.into(), key));
+    }
+
+    /// Draws the legend on `chart`'s plotting area: font `font_px`, `margin` and `key_area`
+    /// in pixels. Nothing is drawn without entries.
+    pub(crate) fn draw<DB: DrawingBackend, CT: plotters::coord::CoordTranslate>(
+        &self,
+        chart: &ChartContext<'_, DB, CT>,
+        position: SeriesLabelPosition,
+        font_px: f64,
+        margin: i32,
+        key_area: i32,
+    ) -> crate::error::Result<()> {
+        if self.entries.is_empty() {
+            return Ok(());
+        }
+        let area = chart.plotting_area().strip_coord_spec();
+        let font: TextStyle = ("sans-serif", font_px).into_font().into();
+        let line = font_px * 1.25;
+        let mut sizes = Vec::with_capacity(self.entries.len());
+        let (mut w, mut h) = (0, 0);
+        for (k, (label, _)) in self.entries.iter().enumerate() {
+            let (tw, th) = area
+                .estimate_text_size(label, &font)
+                .map_err(render_error)?;
+            let y = (k as f64 * line).round() as i32;
+            w = w.max(tw as i32);
+            h = h.max(y + th as i32);
+            sizes.push((y, th as i32));
+        }
+        let (w, h) = (w + key_area + 2 * margin, h + 2 * margin);
+        let (aw, ah) = area.dim_in_pixel();
+        let (aw, ah) = (aw as i32, ah as i32);
+        use SeriesLabelPosition::*;
+        let x0 = match position {
+            UpperLeft | MiddleLeft | LowerLeft => 5,
+            UpperMiddle | MiddleMiddle | LowerMiddle => (aw - w) / 2,
+            UpperRight | MiddleRight | LowerRight => aw - w - 5,
+            Coordinate(x, _) => x,
+        };
+        let y0 = match position {
+            UpperLeft | UpperMiddle | UpperRight => 5,
+            MiddleLeft | MiddleMiddle | MiddleRight => (ah - h) / 2,
+            LowerLeft | LowerMiddle | LowerRight => ah - h - 5,
+            Coordinate(_, y) => y,
+        };
+        let frame = [(x0, y0), (x0 + w, y0 + h)];
+        area.draw(&Rectangle::new(frame, WHITE.mix(0.85).filled()))
+            .map_err(render_error)?;
+        area.draw(&Rectangle::new(frame, RGBColor(180, 180, 180)))
+            .map_err(render_error)?;
+        for ((label, key), (dy, th)) in self.entries.iter().zip(sizes) {
+            let top = y0 + margin + dy;
+            area.draw(&Text::new(
+                label.as_str(),
+                (x0 + key_area + margin, top),
+                &font,
+            ))
+            .map_err(render_error)?;
+            let (x, y) = (x0 + margin, top + th / 2);
+            match *key {
+                Key::Line { len, style } => area
+                    .draw(&PathElement::new(vec![(x, y), (x + len, y)], style))
+                    .map_err(render_error)?,
+                Key::Dot { dx, radius, style } => area
+                    .draw(&Circle::new((x + dx, y), radius, style))
+                    .map_err(render_error)?,
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Self::draw`] with the compact layout of the simulation charts (font 12, margin 6,
+    /// key column 22, scaled).
+    pub(crate) fn draw_compact<DB: DrawingBackend, CT: plotters::coord::CoordTranslate>(
+        &self,
+        chart: &ChartContext<'_, DB, CT>,
+        position: SeriesLabelPosition,
+        style: &ChartStyle,
+    ) -> crate::error::Result<()> {
+        self.draw(
+            chart,
+            position,
+            style.font(12.0),
+            style.px(6.0) as i32,
+            style.px(22.0) as i32,
+        )
+    }
+
+    /// [`Self::draw`] with plotters' default layout (margin 10, key column 30) at font 12,
+    /// scaled.
+    pub(crate) fn draw_default<DB: DrawingBackend, CT: plotters::coord::CoordTranslate>(
+        &self,
+        chart: &ChartContext<'_, DB, CT>,
+        position: SeriesLabelPosition,
+        style: &ChartStyle,
+    ) -> crate::error::Result<()> {
+        self.draw(chart, position, style.font(12.0), 10, 30)
+    }
 }
 
 #[cfg(test)]

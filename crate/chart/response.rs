@@ -2,9 +2,7 @@
 //! shaped ones (top panel), and the deflection endpoint − base, where the vibration shows at
 //! full scale (bottom panel).
 
-use super::{
-    decimate, draw_legend, padded_range, render_error, swatch, ChartStyle, UNSHAPED_COLOR,
-};
+use super::{decimate, padded_range, render_error, swatch, ChartStyle, Legend, UNSHAPED_COLOR};
 use crate::error::Result;
 use crate::simulate::Trajectory;
 use plotters::coord::Shift;
@@ -74,6 +72,7 @@ pub fn draw_response<DB: DrawingBackend>(
             mesh.x_desc("time (s)");
         }
         mesh.draw().map_err(render_error)?;
+        let mut keys = Legend::default();
         for (label, traj, color) in &all {
             let width = if *label == "unshaped" { 1.5 } else { 2.0 };
             chart
@@ -81,12 +80,11 @@ pub fn draw_response<DB: DrawingBackend>(
                     decimate(&traj.time, pick(traj), buckets),
                     color.stroke_width(style.px(width)),
                 ))
-                .map_err(render_error)?
-                .label(label.to_string())
-                .legend(swatch(*color, style));
+                .map_err(render_error)?;
+            keys.push(*label, swatch(*color, style));
         }
         if legend {
-            draw_legend(&mut chart, SeriesLabelPosition::LowerRight, style)?;
+            keys.draw_compact(&chart, SeriesLabelPosition::LowerRight, style)?;
         }
     }
     area.present().map_err(render_error)?;

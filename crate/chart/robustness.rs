@@ -5,7 +5,7 @@
 //! Family names are placed beside their points, moved above, below or to the left when they
 //! would overlap a name already placed (a greedy search in pixel space).
 
-use super::{draw_legend, render_error, ChartStyle};
+use super::{render_error, ChartStyle, Key, Legend};
 use crate::error::Result;
 use crate::robustness::RobustnessRow;
 use plotters::coord::Shift;
@@ -83,9 +83,16 @@ pub fn draw_robustness<DB: DrawingBackend>(
                 .filter(valid)
                 .map(|r| Circle::new((r.duration_periods, r.insensitivity), dot, grey.filled())),
         )
-        .map_err(render_error)?
-        .label("families (for mode 1)")
-        .legend(move |(x, y)| Circle::new((x + 8, y), dot, grey.filled()));
+        .map_err(render_error)?;
+    let mut keys = Legend::default();
+    keys.push(
+        "families (for mode 1)",
+        Key::Dot {
+            dx: 8,
+            radius: dot as i32,
+            style: grey.filled(),
+        },
+    );
     // Names, avoiding each other, the plot's edges and the points.
     let font_px = style.font(11.0);
     let font = ("sans-serif", font_px)
@@ -160,12 +167,18 @@ pub fn draw_robustness<DB: DrawingBackend>(
                 ring,
                 color.stroke_width(width),
             )))
-            .map_err(render_error)?
-            .label(m.label.to_string())
-            .legend(move |(x, y)| Circle::new((x + 8, y), ring.min(8), color.stroke_width(width)));
+            .map_err(render_error)?;
+        keys.push(
+            m.label,
+            Key::Dot {
+                dx: 8,
+                radius: ring.min(8) as i32,
+                style: color.stroke_width(width),
+            },
+        );
     }
     // Upper left: short, very insensitive shapers do not exist, so no point hides there.
-    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, style)?;
+    keys.draw_compact(&chart, SeriesLabelPosition::UpperLeft, style)?;
     area.present().map_err(render_error)?;
     Ok(())
 }

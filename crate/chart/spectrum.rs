@@ -3,7 +3,7 @@
 //! modes by dashed ones — a shaped command should have (almost) no content at the modes
 //! (Veciana & Cardona 2011 §2).
 
-use super::{draw_legend, render_error, swatch, ChartStyle, UNSHAPED_COLOR};
+use super::{render_error, swatch, ChartStyle, Legend, UNSHAPED_COLOR};
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -62,25 +62,26 @@ pub fn draw_spectrum<DB: DrawingBackend>(
         .light_line_style(RGBColor(238, 238, 238))
         .draw()
         .map_err(render_error)?;
+    let mut keys = Legend::default();
     let marker = RGBColor(90, 90, 90);
     let inside = |f: &&f64| (f_lo..=f_hi).contains(*f);
     let mut first = true;
     for &f in modes_hz.iter().filter(inside) {
-        let s = chart
+        chart
             .draw_series(LineSeries::new(
                 [(f, 0.0), (f, top)],
                 marker.stroke_width(style.px(1.0)),
             ))
             .map_err(render_error)?;
         if std::mem::take(&mut first) {
-            s.label("model modes").legend(swatch(marker, style));
+            keys.push("model modes", swatch(marker, style));
         }
     }
     let actual = RGBColor(200, 30, 30);
     let differs = |a: f64| !modes_hz.iter().any(|m| (m - a).abs() <= 1e-9 * m.abs());
     let mut first = true;
     for &f in actual_hz.iter().filter(inside).filter(|a| differs(**a)) {
-        let s = chart
+        chart
             .draw_series(DashedLineSeries::new(
                 [(f, 0.0), (f, top)],
                 style.px(6.0),
@@ -89,7 +90,7 @@ pub fn draw_spectrum<DB: DrawingBackend>(
             ))
             .map_err(render_error)?;
         if std::mem::take(&mut first) {
-            s.label("actual modes").legend(swatch(actual, style));
+            keys.push("actual modes", swatch(actual, style));
         }
     }
     let all = std::iter::once(("unshaped", unshaped, UNSHAPED_COLOR)).chain(
@@ -108,11 +109,10 @@ pub fn draw_spectrum<DB: DrawingBackend>(
                     .map(|(&f, &v)| (f, v)),
                 color.stroke_width(style.px(if label == "unshaped" { 1.5 } else { 2.0 })),
             ))
-            .map_err(render_error)?
-            .label(label.to_string())
-            .legend(swatch(color, style));
+            .map_err(render_error)?;
+        keys.push(label, swatch(color, style));
     }
-    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, style)?;
+    keys.draw_compact(&chart, SeriesLabelPosition::UpperRight, style)?;
     area.present().map_err(render_error)?;
     Ok(())
 }
