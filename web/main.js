@@ -32,6 +32,35 @@ const fmt = (x, digits = 6) => (Number.isFinite(x) ? String(Number(x.toPrecision
 const fmtPct = (fraction) => (Math.abs(fraction) < 1e-11 ? '≈ 0' : fmt(fraction * 100, 4));
 const readNumber = (input) => (input.value.trim() === '' ? NaN : Number(input.value));
 
+/**
+ * Makes `section` (a thead/tbody) hold `rows` — arrays of cell texts, the first `heads` cells
+ * of each row `<th scope="row">`, the rest `<td>` — reusing the rows and cells already there
+ * and writing only the texts that changed. Every input event redraws the tables; rebuilding
+ * them made the browser restyle and lay out hundreds of new nodes per update.
+ */
+function syncRows(section, rows, heads = 1) {
+  while (section.rows.length > rows.length) section.deleteRow(-1);
+  rows.forEach((cells, i) => {
+    const tr = section.rows[i] ?? section.appendChild(document.createElement('tr'));
+    if (tr.cells.length !== cells.length || [...tr.cells].some((c, j) => (c.tagName === 'TH') !== (j < heads))) {
+      tr.replaceChildren(...cells.map((text, j) => (j < heads ? el('th', { scope: 'row' }, text) : el('td', {}, text))));
+      return;
+    }
+    cells.forEach((text, j) => {
+      const cell = tr.cells[j];
+      if (cell.textContent !== text) cell.textContent = text;
+    });
+  });
+}
+
+/** Replaces `node`'s children with `build()` only when `key` differs from the last one used. */
+function rebuildIf(node, key, build) {
+  if (node.dataset.key === key) return false;
+  node.replaceChildren(...build());
+  node.dataset.key = key;
+  return true;
+}
+
 // Frequency sliders are logarithmic: 0.01 Hz … 1 kHz over 0 … 1000.
 const F_MIN = 0.01;
 const F_DECADES = 5;
@@ -206,9 +235,9 @@ function showError(error) {
 // ---------- results ----------
 function showResults(result, st) {
   const { results } = result;
-  const head = el('tr', {}, el('th', { scope: 'col' }, ''),
-    ...results.map((r, k) => el('th', { scope: 'col' }, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), r.label)));
-  $('summary').tHead.replaceChildren(head);
+  const labels = JSON.stringify(results.map((r) => r.label));
+  rebuildIf($('summary').tHead, labels, () => [el('tr', {}, el('th', { scope: 'col' }, ''),
+    ...results.map((r, k) => el('th', { scope: 'col' }, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), r.label)))]);
   const period = 1 / (st.modes[0].frequencyHz * Math.sqrt(1 - st.modes[0].damping ** 2));
   const vtolPct = fmt(st.view.vtol * 100, 4);
   const rows = [
@@ -225,21 +254,22 @@ function showResults(result, st) {
   });
   rows.push(['Klipper smoothing at 5000 mm/s² (mm)', (r) => (r.klipper == null ? 'n/a (Σ amplitudes = 0)' : fmt(r.klipper.smoothing, 4))]);
   rows.push(['Klipper max accel (mm/s²)', (r) => (r.klipper == null ? 'n/a' : r.klipper.maxAccel == null ? '∞' : fmt(r.klipper.maxAccel, 5))]);
-  $('summary').tBodies[0].replaceChildren(...rows.map(([name, f]) => el('tr', {},
-    el('th', { scope: 'row' }, name), ...results.map((r) => el('td', {}, f(r))))));
+  syncRows($('summary').tBodies[0], rows.map(([name, f]) => [name, ...results.map((r) => f(r))]));
 
   showSimulation(result);
 
-  $('impulse-tables').replaceChildren(...results.map((r, k) => el('table', { class: 'impulses', id: `impulses-${k}` },
+  rebuildIf($('impulse-tables'), labels, () => results.map((r, k) => el('table', { class: 'impulses', id: `impulses-${k}` },
     el('caption', {}, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), r.label),
     el('thead', {}, el('tr', {}, el('th', { scope: 'col' }, '#'), el('th', { scope: 'col' }, 'time (s)'), el('th', { scope: 'col' }, 'amplitude'))),
-    el('tbody', {}, ...r.shaper.impulses.map((imp, i) => el('tr', {},
-      el('td', {}, String(i + 1)), el('td', {}, fmt(imp.time, 10)), el('td', {}, fmt(imp.amplitude, 10))))))));
+    el('tbody', {}))));
+  results.forEach((r, k) => syncRows($(`impulses-${k}`).tBodies[0],
+    r.shaper.impulses.map((imp, i) => [String(i + 1), fmt(imp.time, 10), fmt(imp.amplitude, 10)]), 0));
 
   const sel = $('export-shaper');
   const keep = sel.value;
-  sel.replaceChildren(...results.map((r, k) => el('option', { value: String(k) }, r.label)));
-  sel.value = keep && Number(keep) < results.length ? keep : '0';
+  if (rebuildIf(sel, labels, () => results.map((r, k) => el('option', { value: String(k) }, r.label)))) {
+    sel.value = keep && Number(keep) < results.length ? keep : '0';
+  }
   showExport();
 }
 
@@ -248,8 +278,8 @@ function showSimulation(result) {
   const sim = result.simulation;
   const columns = [{ label: 'Unshaped', color: '#6e6e6e', m: sim.unshaped },
     ...result.results.map((r, k) => ({ label: r.label, color: COLORS[k], m: r.simulation }))];
-  $('simulation-summary').tHead.replaceChildren(el('tr', {}, el('th', { scope: 'col' }, ''),
-    ...columns.map((c) => el('th', { scope: 'col' }, el('span', { class: 'swatch', style: `background:${c.color}` }), c.label))));
+  rebuildIf($('simulation-summary').tHead, JSON.stringify(columns.map((c) => c.label)), () => [el('tr', {}, el('th', { scope: 'col' }, ''),
+    ...columns.map((c) => el('th', { scope: 'col' }, el('span', { class: 'swatch', style: `background:${c.color}` }), c.label)))]);
   const pct = (x) => (x == null ? '—' : Math.abs(x) < 1e-9 ? '≈ 0' : fmt(x, 4));
   const num = (x, d = 5) => (x == null ? '—' : fmt(x, d));
   const rows = [
@@ -261,8 +291,7 @@ function showSimulation(result) {
     ['Peak command acceleration', (m) => (m.peakAcceleration == null ? '∞ (velocity jumps)' : fmt(m.peakAcceleration, 5))],
     ['Acceleration peaks + valleys', (m) => String(m.accelerationPeakValleyCount)],
   ];
-  $('simulation-summary').tBodies[0].replaceChildren(...rows.map(([name, f]) => el('tr', {},
-    el('th', { scope: 'row' }, name), ...columns.map((c) => el('td', {}, c.m ? f(c.m) : '—')))));
+  syncRows($('simulation-summary').tBodies[0], rows.map(([name, f]) => [name, ...columns.map((c) => (c.m ? f(c.m) : '—'))]));
   const plant = sim.plant === 'pendulum' ? 'nonlinear pendulum' : 'modal plant';
   $('simulation-note').textContent = `(${plant}, actual modes ${sim.plantModesHz.map((f) => fmt(f, 4)).join(', ')} Hz = model × ${fmt(sim.mismatch, 4)}; ${sim.samples} samples over ${fmt(sim.duration, 4)} s)`;
 }
