@@ -448,12 +448,17 @@ impl Lti {
                     }
                 }
             }
-            for kk in 0..q {
-                let d = self.d[(row, kk)];
-                if d != 0.0 {
-                    for (y, wk) in out.iter_mut().zip(w.chunks_exact(q)) {
-                        *y += d * wk[kk];
-                    }
+            let mut dk = [0.0; ORDER];
+            for (kk, v) in dk.iter_mut().enumerate().take(q) {
+                *v = self.d[(row, kk)];
+            }
+            if dk.iter().any(|&v| v != 0.0) {
+                match q {
+                    1 => feedthrough::<1>(out, &w, &dk),
+                    2 => feedthrough::<2>(out, &w, &dk),
+                    3 => feedthrough::<3>(out, &w, &dk),
+                    4 => feedthrough::<4>(out, &w, &dk),
+                    _ => feedthrough::<0>(out, &w, &dk[..q]),
                 }
             }
         }
@@ -595,6 +600,23 @@ fn march_group<const Q: usize>(
         w_prev = wk;
     }
     rows
+}
+
+/// `out[k] += D_row · w_k` in one pass over the samples (`Q` command derivatives per sample,
+/// or 0 for `d.len()` of them, loops not unrolled).
+fn feedthrough<const Q: usize>(out: &mut [f64], w: &[f64], d: &[f64]) {
+    let q = if Q == 0 { d.len() } else { Q };
+    let mut dk = [0.0; ORDER];
+    for (a, b) in dk.iter_mut().zip(d) {
+        *a = *b;
+    }
+    for (y, wk) in out.iter_mut().zip(w.chunks_exact(q.max(1))) {
+        let mut s = 0.0;
+        for (a, v) in dk.iter().zip(wk).take(q) {
+            s += a * v;
+        }
+        *y += s;
+    }
 }
 
 /// `out[k] += Σ_{j < LEN} coef[j] · rows[k][OFF + j]`.
@@ -870,16 +892,15 @@ mod expm_tests {
             let mut z = z0.to_vec();
             g.apply(delta, &mut z, &mut Vec::new());
             let maps = lti.block_maps((0, 2), 4, delta).unwrap();
-            for i in 0..2 {
+            for (i, got) in z.iter().enumerate().take(2) {
                 let want: f64 = (0..2).map(|j| maps.phi[i * 2 + j] * z0[j]).sum::<f64>()
                     + (0..4)
                         .map(|k| maps.gamma[i * 4 + k] * z0[2 + k])
                         .sum::<f64>();
                 let scale = want.abs().max(1.0);
                 assert!(
-                    (z[i] - want).abs() <= 1e-13 * scale,
-                    "δ {delta}: {} vs {want}",
-                    z[i]
+                    (got - want).abs() <= 1e-13 * scale,
+                    "δ {delta}: {got} vs {want}"
                 );
             }
         }
