@@ -168,6 +168,33 @@ pub(crate) fn decimate(x: &[f64], y: &[f64], buckets: usize) -> Vec<(f64, f64)> 
     out
 }
 
+/// The series of a time chart: `reference` (label, trajectory) in grey, then each labelled
+/// shaped trajectory in the series colours; and the end of the time axis (the latest finite
+/// last sample time, or 1 s if there is none).
+pub(crate) fn time_series<'a>(
+    reference: (&'a str, &'a crate::simulate::Trajectory),
+    shaped: &[(&'a str, &'a crate::simulate::Trajectory)],
+    style: &ChartStyle,
+) -> (
+    Vec<(&'a str, &'a crate::simulate::Trajectory, RGBColor)>,
+    f64,
+) {
+    let all: Vec<_> = std::iter::once((reference.0, reference.1, UNSHAPED_COLOR))
+        .chain(
+            shaped
+                .iter()
+                .enumerate()
+                .map(|(k, (l, t))| (*l, *t, style.color(k))),
+        )
+        .collect();
+    let t_end = all
+        .iter()
+        .filter_map(|(_, t, _)| t.time.last().copied())
+        .filter(|t| t.is_finite())
+        .fold(0.0_f64, f64::max);
+    (all, if t_end > 0.0 { t_end } else { 1.0 })
+}
+
 /// What a legend entry shows before its label, drawn centred on the label's line.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Key {

@@ -2,7 +2,7 @@
 //! shaped ones (top panel), and the deflection endpoint − base, where the vibration shows at
 //! full scale (bottom panel).
 
-use super::{decimate, padded_range, render_error, swatch, ChartStyle, Legend, UNSHAPED_COLOR};
+use super::{decimate, padded_range, render_error, swatch, time_series, ChartStyle, Legend};
 use crate::error::Result;
 use crate::simulate::Trajectory;
 use plotters::coord::Shift;
@@ -20,21 +20,7 @@ pub fn draw_response<DB: DrawingBackend>(
     style: &ChartStyle,
 ) -> Result<()> {
     area.fill(&WHITE).map_err(render_error)?;
-    let all: Vec<(&str, &Trajectory, RGBColor)> =
-        std::iter::once(("unshaped", unshaped, UNSHAPED_COLOR))
-            .chain(
-                shaped
-                    .iter()
-                    .enumerate()
-                    .map(|(k, (l, t))| (*l, *t, style.color(k))),
-            )
-            .collect();
-    let t_end = all
-        .iter()
-        .filter_map(|(_, t, _)| t.time.last().copied())
-        .filter(|t| t.is_finite())
-        .fold(0.0_f64, f64::max);
-    let t_end = if t_end > 0.0 { t_end } else { 1.0 };
+    let (all, t_end) = time_series(("unshaped", unshaped), shaped, style);
     let (width, _) = area.dim_in_pixel();
     let buckets = (width as usize).max(50);
     let titled = area
