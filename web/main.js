@@ -204,9 +204,11 @@ function rebuild() {
 
 // ---------- errors ----------
 function clearErrors() {
-  for (const e of document.querySelectorAll('#controls .error')) e.textContent = '';
+  // Only the messages that are showing: writing even an empty text makes the browser lay the
+  // page out again, on every input event.
+  for (const e of document.querySelectorAll('#controls .error')) if (e.textContent) e.textContent = '';
   for (const e of document.querySelectorAll('[aria-invalid]')) e.removeAttribute('aria-invalid');
-  $('general-error').textContent = '';
+  if ($('general-error').textContent) $('general-error').textContent = '';
 }
 
 /** Shows a core error next to the input it names (or the closest group), else on top. */
