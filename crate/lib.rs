@@ -51,6 +51,7 @@ pub mod shaper;
 pub mod simulate;
 pub mod smoothing;
 pub mod solve;
+mod sort;
 pub mod spectrum;
 pub mod vibration;
 
