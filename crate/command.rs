@@ -71,7 +71,7 @@ impl Piecewise {
             }
         }
         let mut sorted = knots;
-        sorted.sort_by(|a, b| a.time.total_cmp(&b.time));
+        crate::sort::sort_by(&mut sorted, |a, b| a.time.total_cmp(&b.time));
         let span = match (sorted.first(), sorted.last()) {
             (Some(a), Some(b)) => (b.time - a.time).abs().max(a.time.abs()).max(b.time.abs()),
             _ => 0.0,
@@ -475,7 +475,7 @@ impl StreamingShaper {
                 taps.push((n + 1, imp.amplitude * frac));
             }
         }
-        taps.sort_by_key(|t| t.0);
+        crate::sort::sort_by(&mut taps, |a, b| a.0.cmp(&b.0));
         let mut delays = Vec::new();
         let mut weights: Vec<f64> = Vec::new();
         for (d, w) in taps {

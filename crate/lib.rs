@@ -51,11 +51,14 @@ pub mod shaper;
 pub mod simulate;
 pub mod smoothing;
 pub mod solve;
+mod sort;
 pub mod spectrum;
 pub mod vibration;
 
 #[cfg(target_arch = "wasm32")]
 mod canvas;
+#[cfg(target_arch = "wasm32")]
+mod jsde;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 #[cfg(target_arch = "wasm32")]

@@ -96,7 +96,7 @@ impl Shaper {
             return Err(Error::invalid("impulses", "all amplitudes are zero"));
         }
         let mut sorted = impulses;
-        sorted.sort_by(|a, b| a.time.total_cmp(&b.time));
+        crate::sort::sort_by(&mut sorted, |a, b| a.time.total_cmp(&b.time));
         let t0 = sorted[0].time;
         let span = sorted[sorted.len() - 1].time - t0;
         let tol = MERGE_TOLERANCE * span.max(f64::MIN_POSITIVE);

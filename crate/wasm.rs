@@ -55,8 +55,7 @@ pub(crate) fn from_js<T: DeserializeOwned>(value: JsValue, what: &str) -> Result
             reason: "is missing".into(),
         });
     }
-    serde_path_to_error::deserialize(serde_wasm_bindgen::Deserializer::from(value)).map_err(|e| {
-        let path = e.path().to_string();
+    crate::jsde::deserialize(value).map_err(|(path, e)| {
         let field = match path.as_str() {
             "." | "" | "?" => what.to_string(),
             p if what.is_empty() => p.to_string(),
@@ -64,7 +63,7 @@ pub(crate) fn from_js<T: DeserializeOwned>(value: JsValue, what: &str) -> Result
         };
         Error::Parse {
             field,
-            reason: e.into_inner().to_string(),
+            reason: e.to_string(),
         }
     })
 }

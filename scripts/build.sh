@@ -10,7 +10,7 @@ export PATH="$HOME/.cargo/bin:$PATH"
 wasm-pack --log-level warn build --release --target web --out-dir pkg --out-name input_shaping
 wasm=pkg/input_shaping_bg.wasm
 if [ -x node_modules/.bin/wasm-opt ]; then
-  node_modules/.bin/wasm-opt -Oz "$wasm" -o "$wasm.opt" && mv "$wasm.opt" "$wasm"
+  node_modules/.bin/wasm-opt -Oz --converge --one-caller-inline-max-function-size 0 "$wasm" -o "$wasm.opt" && mv "$wasm.opt" "$wasm"
 fi
 raw=$(wc -c < "$wasm")
 gz=$(gzip -9 -c "$wasm" | wc -c)

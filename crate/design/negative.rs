@@ -488,7 +488,7 @@ pub fn bang_bang(mode: &Mode, distance: f64, max_acceleration: f64) -> Result<Sh
     // Shortest starts first; Newton moves t_f by much less than half a period, so starts
     // beyond the best solution so far plus half a period cannot win.
     let mut starts = end_cluster_starts(zeta, delta);
-    starts.sort_by(|a, b| a[3].total_cmp(&b[3]));
+    crate::sort::sort_by(&mut starts, |a, b| a[3].total_cmp(&b[3]));
     let mut best = f64::INFINITY;
     for x0 in &starts {
         if x0[3] > best + PI {

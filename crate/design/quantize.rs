@@ -227,7 +227,9 @@ fn largest_remainder(amplitudes: &[f64], steps: f64) -> Vec<f64> {
     let missing = (target - units.iter().sum::<f64>()).max(0.0) as usize;
     let mut order: Vec<usize> = (0..scaled.len()).collect();
     // Largest remainder first; ties to the earlier impulse (stable sort).
-    order.sort_by(|&i, &j| (scaled[j] - units[j]).total_cmp(&(scaled[i] - units[i])));
+    crate::sort::sort_indices(&mut order, &|i, j| {
+        (scaled[j] - units[j]).total_cmp(&(scaled[i] - units[i]))
+    });
     for &i in order.iter().take(missing) {
         units[i] += 1.0;
     }

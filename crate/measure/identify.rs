@@ -267,9 +267,11 @@ fn detect(psd: &Psd, lo: usize, hi: usize, min_db: f64, max_modes: usize) -> Vec
             });
         }
     }
-    peaks.sort_by(|a, b| b.prominence_db.total_cmp(&a.prominence_db));
+    crate::sort::sort_by(&mut peaks, |a, b| {
+        b.prominence_db.total_cmp(&a.prominence_db)
+    });
     peaks.truncate(max_modes);
-    peaks.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    crate::sort::sort_by(&mut peaks, |a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     peaks
 }
 
@@ -970,9 +972,9 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
             }
         })
         .collect();
-    result
-        .modes
-        .sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    crate::sort::sort_by(&mut result.modes, |a, b| {
+        a.frequency_hz.total_cmp(&b.frequency_hz)
+    });
     result.spectrum = psd;
     Ok(result)
 }

@@ -442,7 +442,7 @@ pub fn recommend(
     let recommended_label;
     match options.criterion {
         Criterion::Duration => {
-            candidates.sort_by(|a, b| {
+            crate::sort::sort_by(&mut candidates, |a, b| {
                 b.acceptable
                     .cmp(&a.acceptable)
                     .then_with(|| {
@@ -480,7 +480,7 @@ pub fn recommend(
                 };
             }
             recommended_label = best.map_or(candidates[0].label.clone(), |b| b.label.clone());
-            candidates.sort_by(|a, b| {
+            crate::sort::sort_by(&mut candidates, |a, b| {
                 a.klipper_score
                     .unwrap_or(f64::INFINITY)
                     .total_cmp(&b.klipper_score.unwrap_or(f64::INFINITY))

@@ -661,7 +661,7 @@ pub(crate) fn polish(norm: &NormalizedProblem, grid: &GridSolution) -> Option<Ve
     let mut wide: Vec<usize> = (0..found.len())
         .filter(|&i| found[i].spacing > 0.0 && found[i].spread > 0.55 * found[i].spacing)
         .collect();
-    wide.sort_by(|&a, &b| {
+    crate::sort::sort_indices(&mut wide, &|a, b| {
         let r = |c: &Cluster| c.spread / c.spacing;
         r(&found[b]).total_cmp(&r(&found[a]))
     });
@@ -733,7 +733,9 @@ fn polish_from(
                 .map(|p| PointSpec::from_peak(norm, p)),
         );
     }
-    candidates.sort_by(|a, b| b.grid_ratio.total_cmp(&a.grid_ratio));
+    crate::sort::sort_by(&mut candidates, |a, b| {
+        b.grid_ratio.total_cmp(&a.grid_ratio)
+    });
     let top = candidates.first().map_or(0.0, |c| c.grid_ratio);
 
     let range = norm.amplitude_max - norm.amplitude_min;
@@ -792,7 +794,9 @@ fn polish_from(
             // from the one the grid solution held furthest below Vtol.
             let base = dropped_from.get_or_insert_with(|| active.points.clone());
             let mut order: Vec<usize> = (0..base.len()).collect();
-            order.sort_by(|&a, &b| base[a].grid_ratio.total_cmp(&base[b].grid_ratio));
+            crate::sort::sort_indices(&mut order, &|a, b| {
+                base[a].grid_ratio.total_cmp(&base[b].grid_ratio)
+            });
             match order.get(drops) {
                 Some(&k) if drops < MAX_DROPS => {
                     let mut points = base.clone();
