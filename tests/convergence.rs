@@ -196,13 +196,24 @@ fn damping_levels(lo: f64, hi: f64) -> Vec<f64> {
 /// n-hump EI promise at one mode, found independently on a dense scan: around the mode, the
 /// contiguous region where V ≤ Vtol holds exactly n + 1 zeros (V = 0) and n humps of height
 /// Vtol between them; the middle hump (n odd) or the middle zero (n even) is at the mode.
+///
+/// With damping the region may have no upper edge: at high frequency V tends to the last
+/// impulse's amplitude, which can be below Vtol, so V ≤ Vtol from the lower edge on (the full
+/// grid's damped 2–4-hump points). Then the promise is checked from the lower edge: the first
+/// n + 1 zeros and the n humps below the last of them, interleaved zero, hump, …, zero; above
+/// that last zero no further zero (every local minimum above 10⁻³ Vtol) and no further hump
+/// (every local maximum below Vtol by 10⁻³ of it) up to the scan's end at 25 f; and beyond the
+/// scan, by the triangle inequality on eq. 11, V stays within
+/// A_last ∓ Σ_{i<last} |Aᵢ| e^{−ζω(t_n − tᵢ)} (a bound that tightens with ω): below Vtol and
+/// above 0, so no zero and no hump hides past the scan either.
 fn check_ei(shaper: &Shaper, f_m: f64, zeta: f64, humps: u32, vtol: f64) -> Result<(), String> {
     let imps = pairs(shaper);
     amplitudes_in(&imps, 0.0, 1.0)?;
     let v = |f: f64| v_eq11(&imps, f, zeta);
     // Dense grid over (0, 25 f_m].
-    let n = scan_points(0.0, 25.0 * f_m, shaper.duration()).max(50_000);
-    let h = 25.0 * f_m / n as f64;
+    let end = 25.0 * f_m;
+    let n = scan_points(0.0, end, shaper.duration()).max(50_000);
+    let h = end / n as f64;
     let grid: Vec<f64> = (1..=n).map(|k| v(h * k as f64)).collect();
     let at = |k: usize| h * (k + 1) as f64;
     let centre = ((f_m / h).round() as usize).saturating_sub(1).min(n - 1);
@@ -217,34 +228,91 @@ fn check_ei(shaper: &Shaper, f_m: f64, zeta: f64, humps: u32, vtol: f64) -> Resu
     while right + 1 < n && grid[right + 1] <= limit {
         right += 1;
     }
-    if left == 0 || right + 1 == n {
+    if left == 0 {
         return Err(format!(
-            "the band V ≤ Vtol around the mode reaches the scan's end ({} … {} Hz)",
+            "the band V ≤ Vtol around the mode reaches 0 Hz ({} … {} Hz)",
             at(left),
             at(right)
         ));
     }
-    // Local minima and maxima of the samples inside [left, right], refined.
+    let open = right + 1 == n;
+    // Local minima and maxima of the samples inside [left, right], refined: `zeros` and `tops`
+    // the candidates for zeros (below Vtol/2) and humps (above Vtol/2), `extrema` all of them
+    // (value, and whether a maximum).
     let (mut zeros, mut tops) = (Vec::new(), Vec::new());
+    let mut extrema: Vec<(f64, f64, bool)> = Vec::new();
+    let distinct =
+        |list: &[(f64, f64)], f: f64| list.last().is_none_or(|&(g, _)| (f - g).abs() > 2.0 * h);
     for k in left.max(1)..=right.min(n - 2) {
         let (a, b) = (at(k) - h, at(k) + h);
-        if grid[k] <= grid[k - 1] && grid[k] <= grid[k + 1] && grid[k] < 0.5 * vtol {
+        if grid[k] <= grid[k - 1] && grid[k] <= grid[k + 1] {
             let (f, val) = golden_min(v, a, b);
-            if zeros
-                .last()
-                .is_none_or(|&(g, _): &(f64, f64)| (f - g).abs() > 2.0 * h)
-            {
+            extrema.push((f, val, false));
+            if grid[k] < 0.5 * vtol && distinct(&zeros, f) {
                 zeros.push((f, val));
             }
         }
-        if grid[k] >= grid[k - 1] && grid[k] >= grid[k + 1] && grid[k] > 0.5 * vtol {
+        if grid[k] >= grid[k - 1] && grid[k] >= grid[k + 1] {
             let (f, val) = golden_max(v, a, b);
-            if tops
-                .last()
-                .is_none_or(|&(g, _): &(f64, f64)| (f - g).abs() > 2.0 * h)
-            {
+            extrema.push((f, val, true));
+            if grid[k] > 0.5 * vtol && distinct(&tops, f) {
                 tops.push((f, val));
             }
+        }
+    }
+    if open {
+        // The promise's part of the band: from the lower edge to the (n + 1)-th zero.
+        let Some(&(cut, _)) = zeros.get(humps as usize) else {
+            return Err(format!(
+                "the band V ≤ Vtol from {} Hz reaches the scan's end ({end} Hz) with only {} \
+                 zeros (expected {}): {zeros:?}",
+                at(left),
+                zeros.len(),
+                humps + 1
+            ));
+        };
+        for &(f, val, is_max) in extrema.iter().filter(|e| e.0 > cut + 2.0 * h) {
+            if is_max && val >= vtol * (1.0 - 1e-3) {
+                return Err(format!(
+                    "a hump of {val} at {f} Hz above the {}-th zero (n = {humps})",
+                    humps + 1
+                ));
+            }
+            if !is_max && val <= 1e-3 * vtol {
+                return Err(format!(
+                    "an extra zero (V = {val:e}) at {f} Hz above the {}-th zero (n = {humps})",
+                    humps + 1
+                ));
+            }
+        }
+        zeros.truncate(humps as usize + 1);
+        tops.retain(|&(f, _)| f < cut);
+        // Interleaved: zero, hump, zero, …, zero.
+        if tops.len() == humps as usize {
+            for (k, &(f, _)) in tops.iter().enumerate() {
+                if !(zeros[k].0 < f && f < zeros[k + 1].0) {
+                    return Err(format!(
+                        "hump at {f} Hz not between the zeros at {} and {} Hz",
+                        zeros[k].0,
+                        zeros[k + 1].0
+                    ));
+                }
+            }
+        }
+        // Beyond the scan: |V − A_last| ≤ Σ_{i<last} |Aᵢ| e^{−ζω(t_n − tᵢ)}, decreasing in ω.
+        let w = 2.0 * PI * end;
+        let t_n = imps.iter().map(|p| p.0).fold(0.0_f64, f64::max);
+        let last: f64 = imps.iter().filter(|p| p.0 == t_n).map(|p| p.1).sum();
+        let rest: f64 = imps
+            .iter()
+            .filter(|p| p.0 < t_n)
+            .map(|p| p.1.abs() * (-zeta * w * (t_n - p.0)).exp())
+            .sum();
+        if last.abs() + rest >= vtol * (1.0 - 1e-3) || last.abs() - rest <= 0.0 {
+            return Err(format!(
+                "the band V ≤ Vtol reaches the scan's end ({end} Hz) and V beyond it is not \
+                 bounded away from Vtol and 0 (last amplitude {last}, rest ≤ {rest:e})"
+            ));
         }
     }
     if zeros.len() != humps as usize + 1 || tops.len() != humps as usize {
@@ -648,4 +716,76 @@ fn full_grid() {
             "sampled",
         ],
     );
+}
+
+/// The full grid's damped n-hump EI points whose band V ≤ Vtol runs past the scan's end
+/// (humps, ζ, Vtol): V tends to the last impulse's amplitude, below Vtol, at high frequency.
+const OPEN_BAND_EI: [(u32, f64, f64); 5] = [
+    (2, 0.25, 0.1),
+    (3, 0.2, 0.1),
+    (3, 0.25, 0.05),
+    (4, 0.15, 0.1),
+    (4, 0.2, 0.05),
+];
+
+fn eihump(humps: u32, zeta: f64, vtol: f64) -> Shaper {
+    design(&DesignRequest {
+        modes: modes_of(&[1.0], zeta),
+        shaper: ShaperSpec::Eihump { humps, vtol },
+    })
+    .unwrap()
+}
+
+/// Those points keep their promise, checked from the band's lower edge (they take that path:
+/// V ≤ Vtol at the scan's end).
+#[test]
+fn ei_open_band_points_keep_their_promise() {
+    for (n, z, vtol) in OPEN_BAND_EI {
+        let s = eihump(n, z, vtol);
+        assert!(
+            v_eq11(&pairs(&s), 25.0, z) < vtol,
+            "n={n} ζ={z}: band not open"
+        );
+        check_ei(&s, 1.0, z, n, vtol).unwrap_or_else(|e| panic!("n={n} ζ={z} Vtol={vtol}: {e}"));
+    }
+}
+
+/// The open-band check still fails wrong shapers: stretched in time (zeros and humps moved off
+/// the mode), an amplitude moved (zeros no longer zero), the wrong hump count, a lower Vtol or
+/// another damping than the design's.
+#[test]
+fn ei_open_band_check_catches_wrong_shapers() {
+    use input_shaping::Impulse;
+    let remake = |s: &Shaper, f: &dyn Fn(usize, &Impulse) -> Impulse| {
+        Shaper::new(
+            s.impulses()
+                .iter()
+                .enumerate()
+                .map(|(k, i)| f(k, i))
+                .collect(),
+        )
+        .unwrap()
+    };
+    for (n, z, vtol) in OPEN_BAND_EI {
+        let s = eihump(n, z, vtol);
+        let stretched = remake(&s, &|_, i| Impulse {
+            time: i.time * 1.002,
+            amplitude: i.amplitude,
+        });
+        let moved = remake(&s, &|k, i| Impulse {
+            time: i.time,
+            amplitude: i.amplitude + [-1e-3, 1e-3].get(k).copied().unwrap_or(0.0),
+        });
+        let wrong = [
+            ("stretched", check_ei(&stretched, 1.0, z, n, vtol)),
+            ("amplitude moved", check_ei(&moved, 1.0, z, n, vtol)),
+            ("one hump more", check_ei(&s, 1.0, z, n + 1, vtol)),
+            ("one hump fewer", check_ei(&s, 1.0, z, n - 1, vtol)),
+            ("lower Vtol", check_ei(&s, 1.0, z, n, vtol * 0.99)),
+            ("other damping", check_ei(&s, 1.0, z * 0.9, n, vtol)),
+        ];
+        for (what, result) in wrong {
+            assert!(result.is_err(), "n={n} ζ={z} Vtol={vtol}: {what} passed");
+        }
+    }
 }

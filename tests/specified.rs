@@ -531,3 +531,56 @@ fn si_spec_from_json() {
         other => panic!("parsed as {other:?}"),
     }
 }
+
+/// The full convergence grid's one real defect (issue 6): SI for four modes (1, 1.1, 3, 10 Hz)
+/// at ζ = 0 and I = 0.9, Vtol 5 %, once returned amplitudes summing to 1 + 1.8·10⁻⁸. Its
+/// results come from the solver's fallback (the polish fails), solved to the duration search's
+/// tolerance 10⁻⁷ and, with no zero constraints, not projected: Σ A = 1 − 5·10⁻⁹ and
+/// 1 − 5·10⁻⁸ in two exchange rounds, the second with an amplitude of −2·10⁻⁶ (refused since
+/// the bounds check of e273eab). Now every result is renormalised to Σ A = 1 before it is
+/// checked, so no shaper with Σ A ≠ 1 can come back: this point must give Σ A = 1 to rounding,
+/// amplitudes within the bounds and V ≤ Vtol on every band — or a typed `infeasible` error,
+/// which is what it gives today (the −2·10⁻⁶ amplitude; a bound-respecting fallback is not
+/// implemented). Slow (≈ 5 min at `--profile bench`, 8 at the test profile; a 1000-impulse
+/// program): `cargo test --profile bench --test specified -- --ignored` (in `npm run test:long`).
+#[test]
+#[ignore = "slow: about 5 minutes at --profile bench; run with --ignored"]
+#[cfg(not(target_arch = "wasm32"))]
+fn four_modes_amplitudes_sum_to_one() {
+    let (vtol, i) = (0.05, 0.9);
+    let freqs = [1.0, 1.1, 3.0, 10.0];
+    let spec = SiSpec {
+        vtol,
+        insensitivity: Some(i),
+        ..SiSpec::default()
+    };
+    let modes: Vec<ModeSpec> = freqs
+        .iter()
+        .map(|&frequency_hz| ModeSpec {
+            frequency_hz,
+            damping: 0.0,
+        })
+        .collect();
+    let s = match design(&spec.request(modes)) {
+        Ok(s) => s,
+        Err(Error::Infeasible { reason }) => {
+            assert!(reason.len() > 20, "an infeasible error says why: {reason}");
+            return;
+        }
+        Err(e) => panic!("neither a shaper nor an infeasible error: {e:?}"),
+    };
+    let sum: f64 = s.impulses().iter().map(|p| p.amplitude).sum();
+    assert!((sum - 1.0).abs() <= 1e-12, "Σ A = {sum}");
+    for p in s.impulses() {
+        assert!(
+            (0.0..=1.0 + 1e-12).contains(&p.amplitude),
+            "amplitude {}",
+            p.amplitude
+        );
+    }
+    for &f in &freqs {
+        let (lo, hi) = (f * (1.0 - i / 2.0), f * (1.0 + i / 2.0));
+        let worst = max_v(&s, lo, hi, 0.0, 2001);
+        assert!(worst <= vtol * (1.0 + 1e-6), "V = {worst} on {lo}…{hi} Hz");
+    }
+}

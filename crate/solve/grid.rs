@@ -25,6 +25,14 @@ use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, S
 /// Most iterations the interior-point solver may take on one program.
 const MAX_SOLVER_ITERATIONS: u32 = 200;
 
+/// The solver's feasibility and gap tolerance in the duration search: it needs the level to
+/// ~1e-6, and the polish makes the result exact.
+pub(crate) const SEARCH_TOLERANCE: f64 = 1e-7;
+/// The same for a result that is returned as it is (the fallback, when the polish fails): Σ A,
+/// the amplitude bounds and the level to near rounding, so that renormalising to Σ A = 1
+/// moves V by far less than the result check's tolerance.
+pub(crate) const EXACT_TOLERANCE: f64 = 1e-10;
+
 /// What the program found on one set of times.
 #[derive(Debug, Clone)]
 pub(crate) struct Outcome {
@@ -36,12 +44,14 @@ pub(crate) struct Outcome {
 
 /// Solves the program on `times` (sorted, first 0; the last is the shaper's end).
 /// `Ok(None)` when no amplitudes satisfy the linear constraints (or the solver fails, which
-/// the callers treat the same way: as "not feasible at this duration").
+/// the callers treat the same way: as "not feasible at this duration"). `tolerance`: the
+/// solver's feasibility and gap tolerance ([`SEARCH_TOLERANCE`] or [`EXACT_TOLERANCE`]).
 pub(crate) fn solve_on_times(
     problem: &NormalizedProblem,
     limits: &[NormalizedLimit],
     times: &[f64],
     increment_max: Option<f64>,
+    tolerance: f64,
 ) -> Result<Option<Outcome>> {
     let n_amp = times.len();
     if n_amp == 0 {
@@ -171,10 +181,9 @@ pub(crate) fn solve_on_times(
         verbose: false,
         max_iter: MAX_SOLVER_ITERATIONS,
         presolve_enable: false,
-        // The duration search needs the level to ~1e-6; the polish makes the result exact.
-        tol_gap_abs: 1e-7,
-        tol_gap_rel: 1e-7,
-        tol_feas: 1e-7,
+        tol_gap_abs: tolerance,
+        tol_gap_rel: tolerance,
+        tol_feas: tolerance,
         iterative_refinement_max_iter: 3,
         ..DefaultSettings::default()
     };
@@ -186,7 +195,9 @@ pub(crate) fn solve_on_times(
     solver.solve();
     let solution = &solver.solution;
     match solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => {}
+        SolverStatus::Solved => {}
+        // "Almost" is the solver's reduced accuracy (~1e-4), useless when asked for exactness.
+        SolverStatus::AlmostSolved if tolerance > EXACT_TOLERANCE => {}
         _ => return Ok(None),
     }
     let amplitudes = solution.x[..n_amp].to_vec();
