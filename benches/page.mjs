@@ -2,8 +2,9 @@
 // recompute everything and redraw every chart (impulses, V(f), V(ζ), the map, the simulated
 // response, the command, its spectrum, robustness), as one input event does — with 3 modes and
 // 4 compared shapers, and report p50 / p95 / max in ms, plus the shipped size (gzip).
-// Two kinds of edit: a mode's frequency (everything recomputed, including the robustness
-// table, designed for mode 1) and the mismatch r (the robustness table comes from the cache).
+// Two kinds of edit: a mode's frequency (every shaper redesigned and every chart recomputed;
+// the robustness background is cached per damping ratio and Vtol, so a frequency edit only
+// rescales it) and the mismatch r (the designs stay; the simulation and its charts change).
 // Run: npm run bench:page   (after npm run build)
 import { chromium } from 'playwright-core';
 import { readFileSync, readdirSync } from 'node:fs';
