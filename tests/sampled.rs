@@ -452,8 +452,8 @@ fn spec_parses_and_errors_name_fields() {
 }
 
 /// The two cases the long property profile shrank to (a prescribed ramp delay, fine sampling,
-/// Σ|A| in the hundreds): the dense KKT solve alone left Σ A off 1 by 3–6·10⁻⁹. With iterative
-/// refinement the constraints of eq. 13 hold to rounding.
+/// large amplitudes that cancel): the dense KKT solve alone left Σ A off 1 by 3–6·10⁻⁹. With
+/// iterative refinement the constraints of eq. 13 hold to rounding.
 #[wasm_bindgen_test(unsupported = test)]
 fn dense_solve_meets_the_constraints_to_rounding() {
     let base = paper_spec();

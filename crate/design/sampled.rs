@@ -595,9 +595,9 @@ fn equality_qp(
         return None;
     }
     let mut z = lu.solve(&rhs)?;
-    // Iterative refinement: with large, cancelling amplitudes (Σ|Aᵢ| in the hundreds) one
-    // solve leaves the constraints off by ~10⁻⁹ (Σ A = 1 − 3·10⁻⁹ on cases the long property
-    // run found); a few corrections from the residual bring them to rounding.
+    // Iterative refinement: with large amplitudes that cancel (fine grid, prescribed delay),
+    // one solve leaves the constraints off by ~10⁻⁹ (Σ A = 1 − 3·10⁻⁹ on cases the long
+    // property run found); a few corrections from the residual bring them to rounding.
     for _ in 0..3 {
         let r = &rhs - &kkt * &z;
         if r.amax() == 0.0 {
