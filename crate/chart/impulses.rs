@@ -76,13 +76,7 @@ pub fn draw_impulses<DB: DrawingBackend>(
                 )
             }))
             .map_err(render_error)?;
-        keys.push(
-            label.to_string(),
-            Key::Line {
-                len: 16,
-                style: color.stroke_width(3),
-            },
-        );
+        keys.push(label.to_string(), Key::line(color.stroke_width(3)));
         let r = style.px(4.0);
         chart
             .draw_series(shaper.impulses().iter().map(|imp| {

@@ -369,13 +369,7 @@ pub fn draw_sensitivity_map_with<DB: DrawingBackend>(
                     .map(|[a, b]| PathElement::new(vec![a, b], line)),
             )
             .map_err(render_error)?;
-        keys.push(
-            format!("V = Vtol ({:.3} %)", vtol * 100.0),
-            Key::Line {
-                len: 16,
-                style: line,
-            },
-        );
+        keys.push(format!("V = Vtol ({:.3} %)", vtol * 100.0), Key::line(line));
     }
     let inside =
         |&&(mf, mz): &&(f64, f64)| (f_lo..=f_hi).contains(&mf) && (z_lo..=z_hi).contains(&mz);

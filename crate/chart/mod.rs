@@ -208,6 +208,13 @@ pub(crate) enum Key {
     },
 }
 
+impl Key {
+    /// A 16-pixel line in `style` (the unscaled keys of the analysis charts).
+    pub(crate) fn line(style: ShapeStyle) -> Key {
+        Key::Line { len: 16, style }
+    }
+}
+
 /// A swatch key: a short thick line of `color`, scaled.
 pub(crate) fn swatch(color: RGBColor, style: &ChartStyle) -> Key {
     Key::Line {

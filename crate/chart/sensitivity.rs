@@ -68,10 +68,7 @@ pub fn draw_sensitivity<DB: DrawingBackend>(
             .map_err(render_error)?;
         keys.push(
             format!("Vtol {:.3} %", vtol * 100.0),
-            Key::Line {
-                len: 16,
-                style: red.stroke_width(2),
-            },
+            Key::line(red.stroke_width(2)),
         );
     }
     for (k, (label, curve)) in curves.iter().enumerate() {
@@ -92,13 +89,7 @@ pub fn draw_sensitivity<DB: DrawingBackend>(
                 color.stroke_width(style.px(2.0)),
             ))
             .map_err(render_error)?;
-        keys.push(
-            label.to_string(),
-            Key::Line {
-                len: 16,
-                style: color.stroke_width(3),
-            },
-        );
+        keys.push(label.to_string(), Key::line(color.stroke_width(3)));
     }
     keys.draw_default(&chart, SeriesLabelPosition::UpperRight, style)?;
     area.present().map_err(render_error)?;
