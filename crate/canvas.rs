@@ -28,8 +28,8 @@ use web_sys::{CanvasRenderingContext2d, HtmlCanvasElement, ImageData};
 /// What was last written to the context (`None`: unknown).
 #[derive(Debug, Default)]
 struct ContextState {
-    stroke: Option<(String, u32)>,
-    fill: Option<String>,
+    stroke: Option<(Rgba, u32)>,
+    fill: Option<Rgba>,
     font: Option<String>,
     align: Option<(&'static str, &'static str)>,
 }
@@ -39,6 +39,14 @@ pub(crate) struct Canvas {
     inner: CanvasBackend,
     context: CanvasRenderingContext2d,
     state: RefCell<ContextState>,
+}
+
+/// A colour compared by value (alpha by its bits), so an unchanged style is recognised
+/// without formatting its CSS string.
+type Rgba = ((u8, u8, u8), u64);
+
+fn rgba(color: BackendColor) -> Rgba {
+    (color.rgb, color.alpha.to_bits())
 }
 
 /// plotters-canvas's colour string.
@@ -93,10 +101,10 @@ impl Canvas {
 
     /// Sets the stroke colour and width unless they are already set.
     fn line_style<S: BackendStyle>(&self, style: &S) {
-        let want = (css_color(style.color()), style.stroke_width());
+        let want = (rgba(style.color()), style.stroke_width());
         let mut st = self.state.borrow_mut();
-        if st.stroke.as_ref() != Some(&want) {
-            self.context.set_stroke_style_str(&want.0);
+        if st.stroke != Some(want) {
+            self.context.set_stroke_style_str(&css_color(style.color()));
             self.context.set_line_width(f64::from(want.1));
             st.stroke = Some(want);
         }
@@ -104,10 +112,10 @@ impl Canvas {
 
     /// Sets the fill colour unless it is already set.
     fn fill_style(&self, color: BackendColor) {
-        let want = css_color(color);
+        let want = rgba(color);
         let mut st = self.state.borrow_mut();
-        if st.fill.as_ref() != Some(&want) {
-            self.context.set_fill_style_str(&want);
+        if st.fill != Some(want) {
+            self.context.set_fill_style_str(&css_color(color));
             st.fill = Some(want);
         }
     }
