@@ -322,10 +322,33 @@ function showExport() {
 }
 
 // ---------- update loop ----------
+// The charts' CSS sizes, kept by a ResizeObserver (its callbacks run just after a layout, so
+// reading the sizes there is free). Reading clientWidth in update() instead would force a
+// layout of the whole page on every edit, since the previous update changed the tables' texts.
+const canvasSizes = new WeakMap();
+const resizeObserver = typeof ResizeObserver === 'function'
+  ? new ResizeObserver((entries) => {
+    let resized = false;
+    for (const { target } of entries) {
+      const size = [target.clientWidth, target.clientHeight];
+      const old = canvasSizes.get(target);
+      if (!old || old[0] !== size[0] || old[1] !== size[1]) resized = true;
+      canvasSizes.set(target, size);
+    }
+    if (resized && lastGood) schedule();
+  })
+  : null;
+
 function sizeCanvas(canvas) {
+  let size = canvasSizes.get(canvas);
+  if (!size) {
+    size = [canvas.clientWidth, canvas.clientHeight];
+    canvasSizes.set(canvas, size);
+    resizeObserver?.observe(canvas);
+  }
   const ratio = window.devicePixelRatio || 1;
-  const w = Math.max(1, Math.round(canvas.clientWidth * ratio));
-  const h = Math.max(1, Math.round(canvas.clientHeight * ratio));
+  const w = Math.max(1, Math.round(size[0] * ratio));
+  const h = Math.max(1, Math.round(size[1] * ratio));
   if (canvas.width !== w || canvas.height !== h) {
     canvas.width = w;
     canvas.height = h;
@@ -364,6 +387,11 @@ function changed(commit = false) {
     else history.replaceState(null, '', hash);
     editing = !commit;
   }
+  schedule();
+}
+
+/** Schedules one update for the next frame (several requests in a frame make one update). */
+function schedule() {
   if (!frame) frame = requestAnimationFrame(() => { frame = 0; update(); });
 }
 
