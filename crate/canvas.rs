@@ -10,8 +10,10 @@
 //! Lines, paths, rectangles and text — hundreds per chart (grid lines, tick labels) — are drawn
 //! here as `CanvasBackend` draws them, except that the stroke style, line width, fill style,
 //! font and text alignment are written to the context only when they differ from what was last
-//! written: each write formats a CSS string that the browser then parses. Bitmaps (the
-//! sensitivity map) are written with one `putImageData`. Everything else is delegated to
+//! written: each write formats a CSS string that the browser then parses. Consecutive lines
+//! of one style become one path with one `stroke`, and text sizes are remembered across frames
+//! (the same tick labels come back on every edit). Bitmaps (the sensitivity map) are written
+//! with one `putImageData`. Everything else is delegated to
 //! `CanvasBackend`, after which the remembered state is forgotten (it may have changed it).
 //! Compiled only for wasm32.
 
@@ -22,6 +24,7 @@ use plotters_backend::{
 };
 use plotters_canvas::CanvasBackend;
 use std::cell::RefCell;
+use std::collections::HashMap;
 use wasm_bindgen::{Clamped, JsCast};
 use web_sys::{CanvasRenderingContext2d, HtmlCanvasElement, ImageData};
 
@@ -32,7 +35,18 @@ struct ContextState {
     fill: Option<Rgba>,
     font: Option<String>,
     align: Option<(&'static str, &'static str)>,
+    /// Lines added to the current path and not yet stroked (in the stroke style above).
+    open_lines: bool,
 }
+
+thread_local! {
+    /// Text sizes already measured, by (font, text): tick labels repeat from frame to frame,
+    /// and each `measureText` is a call into the browser with the text decoded into a JS
+    /// string. Cleared when it grows past [`MEASURED_MAX`] entries.
+    static MEASURED: RefCell<HashMap<(String, String), (u32, u32)>> = RefCell::new(HashMap::new());
+}
+/// Most text sizes [`MEASURED`] keeps.
+const MEASURED_MAX: usize = 4096;
 
 /// A canvas backend whose text measurement does not force a page layout (module docs).
 pub(crate) struct Canvas {
@@ -130,9 +144,26 @@ impl Canvas {
         }
     }
 
+    /// Strokes the lines [`DrawingBackend::draw_line`] has collected, if any. Every drawing
+    /// operation other than a line calls this first, so the drawing order is kept.
+    fn flush(&self) {
+        let mut st = self.state.borrow_mut();
+        if st.open_lines {
+            self.context.stroke();
+            st.open_lines = false;
+        }
+    }
+
     /// After a call delegated to `CanvasBackend`, which may have set any of the state.
     fn forget(&self) {
         *self.state.borrow_mut() = ContextState::default();
+    }
+}
+
+impl Drop for Canvas {
+    /// Strokes the lines still collected when the chart is done with the backend.
+    fn drop(&mut self) {
+        self.flush();
     }
 }
 
@@ -150,10 +181,12 @@ impl DrawingBackend for Canvas {
     }
 
     fn present(&mut self) -> Result<(), Failure> {
+        self.flush();
         self.inner.present()
     }
 
     fn draw_pixel(&mut self, point: BackendCoord, color: BackendColor) -> Result<(), Failure> {
+        self.flush();
         self.forget();
         self.inner.draw_pixel(point, color)
     }
@@ -167,12 +200,22 @@ impl DrawingBackend for Canvas {
         if style.color().alpha == 0.0 {
             return Ok(());
         }
+        // Consecutive lines of one style (a chart's grid lines, its tick marks) are one path
+        // and one `stroke`: each stroke is a separate draw the browser records and rasterises.
         let (a, b) = fine_lines(from, to);
-        self.line_style(style);
-        self.context.begin_path();
+        let want = (rgba(style.color()), style.stroke_width());
+        let same = {
+            let st = self.state.borrow();
+            st.open_lines && st.stroke == Some(want)
+        };
+        if !same {
+            self.flush();
+            self.line_style(style);
+            self.context.begin_path();
+        }
         self.context.move_to(a.0, a.1);
         self.context.line_to(b.0, b.1);
-        self.context.stroke();
+        self.state.borrow_mut().open_lines = true;
         Ok(())
     }
 
@@ -186,6 +229,7 @@ impl DrawingBackend for Canvas {
         if style.color().alpha == 0.0 {
             return Ok(());
         }
+        self.flush();
         let (x, y) = (f64::from(upper_left.0), f64::from(upper_left.1));
         let (w, h) = (
             f64::from(bottom_right.0 - upper_left.0),
@@ -209,6 +253,7 @@ impl DrawingBackend for Canvas {
         if style.color().alpha == 0.0 {
             return Ok(());
         }
+        self.flush();
         let mut path = path.into_iter();
         self.context.begin_path();
         if let Some(start) = path.next() {
@@ -229,6 +274,7 @@ impl DrawingBackend for Canvas {
         style: &S,
         fill: bool,
     ) -> Result<(), Failure> {
+        self.flush();
         self.forget();
         self.inner.draw_circle(center, radius, style, fill)
     }
@@ -238,6 +284,7 @@ impl DrawingBackend for Canvas {
         vert: I,
         style: &S,
     ) -> Result<(), Failure> {
+        self.flush();
         self.forget();
         self.inner.fill_polygon(vert, style)
     }
@@ -252,6 +299,7 @@ impl DrawingBackend for Canvas {
         if color.alpha == 0.0 {
             return Ok(());
         }
+        self.flush();
         let degrees = match style.transform() {
             FontTransform::None => 0.0,
             FontTransform::Rotate90 => 90.0,
@@ -302,6 +350,10 @@ impl DrawingBackend for Canvas {
         style: &S,
     ) -> Result<(u32, u32), Failure> {
         // The font string draw_text sets before fill_text.
+        let key = (css_font(style), text.to_owned());
+        if let Some(size) = MEASURED.with(|m| m.borrow().get(&key).copied()) {
+            return Ok(size);
+        }
         self.font(style);
         match self.context.measure_text(text) {
             Ok(m) => {
@@ -311,7 +363,15 @@ impl DrawingBackend for Canvas {
                 } else {
                     1.15 * style.size()
                 };
-                Ok((m.width().max(0.0).ceil() as u32, height.ceil() as u32))
+                let size = (m.width().max(0.0).ceil() as u32, height.ceil() as u32);
+                MEASURED.with(|m| {
+                    let mut m = m.borrow_mut();
+                    if m.len() >= MEASURED_MAX {
+                        m.clear();
+                    }
+                    m.insert(key, size);
+                });
+                Ok(size)
             }
             // No measurement (never seen): fall back to plotters' own.
             Err(_) => self.inner.estimate_text_size(text, style),
@@ -326,14 +386,19 @@ impl DrawingBackend for Canvas {
         (w, h): (u32, u32),
         src: &[u8],
     ) -> Result<(), Failure> {
+        self.flush();
         let pixels = w as usize * h as usize;
         if w == 0 || h == 0 || src.len() < 3 * pixels {
             self.forget();
             return self.inner.blit_bitmap(pos, (w, h), src);
         }
-        let mut rgba = Vec::with_capacity(4 * pixels);
-        for px in src.chunks_exact(3).take(pixels) {
-            rgba.extend_from_slice(&[px[0], px[1], px[2], 255]);
+        let mut rgba = vec![255; 4 * pixels];
+        for (to, from) in rgba.chunks_exact_mut(4).zip(src.chunks_exact(3)) {
+            // Byte by byte: a 3-byte `copy_from_slice` can be a `memcpy` call per pixel at
+            // opt-level "z".
+            to[0] = from[0];
+            to[1] = from[1];
+            to[2] = from[2];
         }
         let image = ImageData::new_with_u8_clamped_array_and_sh(Clamped(&rgba), w, h);
         match image.and_then(|img| {
