@@ -79,6 +79,10 @@ pub fn contour_segments(map: &SensitivityMap, level: f64) -> Vec<[(f64, f64); 2]
             if corners.iter().any(|c| !c.2.is_finite()) {
                 continue;
             }
+            let above = corners.iter().filter(|c| c.2 > level).count();
+            if above == 0 || above == 4 {
+                continue; // the level does not cross this cell (most cells)
+            }
             // Crossing on edge e (from corner e to corner e+1), if the level separates them.
             let crossing = |e: usize| {
                 let (p, q) = (corners[e], corners[(e + 1) % 4]);
@@ -88,11 +92,15 @@ pub fn contour_segments(map: &SensitivityMap, level: f64) -> Vec<[(f64, f64); 2]
                 let t = (level - p.2) / (q.2 - p.2);
                 Some((p.0 + t * (q.0 - p.0), p.1 + t * (q.1 - p.1)))
             };
-            let cuts: Vec<(usize, (f64, f64))> =
-                (0..4).filter_map(|e| crossing(e).map(|c| (e, c))).collect();
-            match cuts.as_slice() {
-                [(_, a), (_, b)] => segments.push([*a, *b]),
-                [(_, bottom), (_, right), (_, top), (_, left)] => {
+            let mut cuts = [(0.0, 0.0); 4];
+            let mut n = 0;
+            for c in (0..4).filter_map(crossing) {
+                cuts[n] = c;
+                n += 1;
+            }
+            match &cuts[..n] {
+                [a, b] => segments.push([*a, *b]),
+                [bottom, right, top, left] => {
                     let mean = corners.iter().map(|c| c.2).sum::<f64>() / 4.0;
                     if (mean > level) == (corners[0].2 > level) {
                         // The bottom-left and top-right corners connect through the centre:
@@ -208,6 +216,7 @@ pub fn raster_cells(
 ) -> Bitmap {
     let (w, h) = ((x.1 - x.0).max(0) as usize, (y.1 - y.0).max(0) as usize);
     let nf = map.frequency_hz.len();
+    let palette: Vec<RGBColor> = (0..COLOR_LEVELS).map(level_color).collect();
     let cell = |edges: &[i32], p: i32, rising: bool| -> Option<usize> {
         (0..edges.len().saturating_sub(1)).find(|&j| {
             let (a, b) = (edges[j], edges[j + 1]);
@@ -220,25 +229,28 @@ pub fn raster_cells(
     };
     let columns: Vec<Option<usize>> = (x.0..x.1).map(|p| cell(xe, p, true)).collect();
     let mut rgb = vec![255; 3 * w * h];
-    let mut colors = vec![(0, 0, 0); nf];
-    let mut last_row = None;
-    for (py, line) in (y.0..y.1).zip(rgb.chunks_exact_mut(3 * w.max(1))) {
+    let stride = 3 * w;
+    // Each row of cells is coloured once; the further pixel rows it covers are copies.
+    let mut last_row: Option<(usize, usize)> = None; // (cell row, its first pixel row)
+    for (i, py) in (y.0..y.1).enumerate() {
         let Some(k) = cell(ye, py, false) else {
             continue;
         };
-        if last_row != Some(k) {
-            let row = map.vibration.get(k * nf..(k + 1) * nf).unwrap_or(&[]);
-            for (c, &v) in colors.iter_mut().zip(row) {
-                let RGBColor(r, g, b) = level_color(level(v, top));
-                *c = (r, g, b);
-            }
-            last_row = Some(k);
+        let start = i * stride;
+        if let Some((_, from)) = last_row.filter(|&(row, _)| row == k) {
+            rgb.copy_within(from..from + stride, start);
+            continue;
         }
-        for (px, col) in line.chunks_exact_mut(3).zip(&columns) {
-            if let Some((r, g, b)) = col.and_then(|j| colors.get(j).copied()) {
-                px.copy_from_slice(&[r, g, b]);
+        let values = map.vibration.get(k * nf..(k + 1) * nf).unwrap_or(&[]);
+        let colors: Vec<RGBColor> = values.iter().map(|&v| palette[level(v, top)]).collect();
+        for (px, col) in rgb[start..start + stride].chunks_exact_mut(3).zip(&columns) {
+            if let Some(&RGBColor(r, g, b)) = col.and_then(|j| colors.get(j)) {
+                px[0] = r;
+                px[1] = g;
+                px[2] = b;
             }
         }
+        last_row = Some((k, start));
     }
     Bitmap {
         origin: (0, 0),
