@@ -5,7 +5,12 @@
 // Two kinds of edit: a mode's frequency (every shaper redesigned and every chart recomputed;
 // the robustness background is cached per damping ratio and Vtol, so a frequency edit only
 // rescales it) and the mismatch r (the designs stay; the simulation and its charts change).
-// Run: npm run bench:page   (after npm run build)
+// Each update runs in an animation frame of its own, as the page schedules them (one update
+// per frame, however many input events came). Back-to-back updates with no frame between them
+// pile up the canvases' recorded drawing until the browser rasterises several frames of it
+// inside one update: that gave the 200–500 ms maxima reported before this pacing.
+// Run: npm run bench:page   (after npm run build); RUNS=n sets the updates per case (200),
+// SHAPERS=1 or SHAPERS=4 runs only the cases with that many shapers.
 import { chromium } from 'playwright-core';
 import { readFileSync, readdirSync } from 'node:fs';
 import { gzipSync } from 'node:zlib';
@@ -35,15 +40,19 @@ try {
   await page.goto(`${url}#state=${encodeURIComponent(JSON.stringify(state))}`);
   await page.waitForSelector('body[data-ready="true"]');
   const charts = await page.$$eval('.charts canvas', (c) => c.length);
-  for (const [shapers, edit] of [[4, 'mode'], [4, 'mismatch'], [1, 'mode'], [1, 'mismatch']]) {
+  const cases = [[4, 'mode'], [4, 'mismatch'], [1, 'mode'], [1, 'mismatch']]
+    .filter(([n]) => !process.env.SHAPERS || Number(process.env.SHAPERS) === n);
+  for (const [shapers, edit] of cases) {
     if (shapers === 1) {
       await page.evaluate(() => { const pg = window.__playground; pg.state.shapers.splice(1); pg.state.shapers[0] = { family: 'zvd' }; pg.state.view.mapShaper = 0; pg.update(); });
     }
     const times = await page.evaluate(async ([runs, what]) => {
       const out = [];
       const pg = window.__playground;
-      for (let i = 0; i < 10; i++) pg.update(); // warm up
+      const frame = () => new Promise((done) => requestAnimationFrame(done));
+      for (let i = 0; i < 10; i++) { await frame(); pg.update(); } // warm up
       for (let i = 0; i < runs; i++) {
+        await frame();
         if (what === 'mode') pg.state.modes[0].frequencyHz = 1.2 + (i % 10) * 0.01;
         else pg.state.view.mismatch = 0.8 + (i % 40) * 0.01;
         out.push(pg.update());
