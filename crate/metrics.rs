@@ -180,18 +180,31 @@ pub fn mode_residual_percent(plant: &ModalPlant, command: &Piecewise) -> Result<
 }
 
 /// Values of the `order`-th derivative of a piecewise command: 0 before it starts, each piece
-/// at [`PER_PIECE`] + 1 points, and its final value.
+/// at [`PER_PIECE`] + 1 points, and its final value. Where that derivative is linear on every
+/// piece (`order` ≥ degree − 1: the acceleration of trapezoids and S-curves, shaped or not),
+/// each piece is monotone and only its two ends are sampled: the interior points could not
+/// change the peak |value| or the turning points [`peak_valley_count`] finds.
 fn sample_derivative(p: &Piecewise, order: usize) -> Vec<f64> {
+    let per_piece = if p.degree() <= order + 1 {
+        1
+    } else {
+        PER_PIECE
+    };
+    sample_derivative_at(p, order, per_piece)
+}
+
+/// [`sample_derivative`] with `per_piece` + 1 points per piece (`per_piece` ≥ 1).
+fn sample_derivative_at(p: &Piecewise, order: usize, per_piece: usize) -> Vec<f64> {
     let knots = p.knots();
-    let mut out = Vec::with_capacity(knots.len() * (PER_PIECE + 1) + 2);
+    let mut out = Vec::with_capacity(knots.len() * (per_piece + 1) + 2);
     out.push(0.0);
     let mut cursor = Cursor::new(p);
     for (i, k) in knots.iter().enumerate() {
         cursor.seek(k.time);
         match knots.get(i + 1) {
             Some(next) => {
-                for j in 0..=PER_PIECE {
-                    let t = k.time + (next.time - k.time) * j as f64 / PER_PIECE as f64;
+                for j in 0..=per_piece {
+                    let t = k.time + (next.time - k.time) * j as f64 / per_piece as f64;
                     out.push(cursor.state_at(t)[order]);
                 }
             }
@@ -280,4 +293,54 @@ pub fn peak_valley_count(x: &[f64]) -> usize {
         }
     }
     count
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{peak_valley_count, sample_derivative, sample_derivative_at, PER_PIECE};
+    use crate::command::{s_curve, trapezoid};
+    use crate::design::zero_vibration::{zv, zvd};
+    use crate::mode::Mode;
+
+    /// Where a derivative is linear on every piece, sampling only the pieces' ends gives the
+    /// peak and the turning points of the dense sampling (independent computation: 64 points
+    /// per piece), for trapezoids and S-curves, unshaped and shaped by ZV and ZVD at several
+    /// modes (overlapping impulse responses make pieces of every slope).
+    #[test]
+    fn piece_ends_give_the_dense_peaks_and_turning_points_where_the_derivative_is_linear() {
+        let mut commands = vec![
+            trapezoid(1.0, 0.8, 2.0, 0.0).unwrap(),
+            s_curve(1.0, 0.8, 2.0, 20.0, 0.0).unwrap(),
+            s_curve(1.0, 0.5, 100.0, 22.2, 0.1).unwrap(),
+        ];
+        for f in [0.7, 1.0, 2.3, 9.0] {
+            let mode = Mode::new(f, 0.05).unwrap();
+            for base in commands.clone().iter().take(3) {
+                commands.push(base.shaped(&zv(&mode).unwrap()).unwrap());
+                commands.push(base.shaped(&zvd(&mode).unwrap()).unwrap());
+            }
+        }
+        let mut sparse_used = 0;
+        for p in &commands {
+            for order in 1..=3 {
+                let fast = sample_derivative(p, order);
+                let dense = sample_derivative_at(p, order, PER_PIECE);
+                let peak = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+                let (a, b) = (peak(&fast), peak(&dense));
+                assert!(
+                    (a - b).abs() <= 1e-12 * b.max(1.0),
+                    "order {order}: {a} vs {b}"
+                );
+                assert_eq!(
+                    peak_valley_count(&fast),
+                    peak_valley_count(&dense),
+                    "order {order}"
+                );
+                if fast.len() < dense.len() {
+                    sparse_used += 1;
+                }
+            }
+        }
+        assert!(sparse_used >= 20, "the sparse path ran {sparse_used} times");
+    }
 }
