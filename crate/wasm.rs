@@ -310,7 +310,7 @@ fn default_gravity() -> f64 {
 }
 
 /// Everything the page shows about one shaper.
-#[derive(Serialize)]
+#[derive(Serialize, Clone)]
 #[serde(rename_all = "camelCase")]
 struct ShaperResult {
     label: String,
@@ -533,6 +533,181 @@ fn robustness_rows(mode: &Mode, vtol: f64) -> Result<Vec<RobustnessRow>, Error> 
         .collect())
 }
 
+/// The part of a frame that depends on the designs and the analysis settings only, not on the
+/// simulated plant, the mismatch or the command: what [`ANALYSIS`] keeps between frames.
+#[derive(Clone)]
+struct Analysis {
+    shapers: Vec<Shaper>,
+    /// Per shaper, everything but the simulation's metrics (`simulation` is `None`).
+    results: Vec<ShaperResult>,
+    /// V(ζ) of every shaper at mode 1, if the damping chart is drawn.
+    damping_curves: Option<Vec<vibration::DampingSensitivityCurve>>,
+    /// The map of the chosen shaper, if the map is drawn.
+    map: Option<vibration::SensitivityMap>,
+    /// |S(f)| of every shaper on the spectrum's grid, if the spectrum is drawn (`None` for the
+    /// families that make their own move, whose spectrum is the move's).
+    impulse_spectra: Option<Vec<Option<Vec<f64>>>>,
+}
+
+/// Everything [`Analysis`] is computed from.
+#[derive(Clone, PartialEq)]
+struct AnalysisKey {
+    specs: Vec<ShaperSpec>,
+    modes: Vec<ModeSpec>,
+    /// vtol, scv, the V(f) range and points, the damping range and points, the map's shaper
+    /// and resolution, the spectrum's points (floats as bits).
+    numbers: [u64; 11],
+    /// Which of the damping, map and spectrum charts are drawn.
+    charts: [bool; 3],
+}
+
+thread_local! {
+    /// The last frame's [`Analysis`] and its key. Dragging the mismatch, or editing the
+    /// command or the plant, changes only the simulation: the designs, I(Vtol), V(f), V(ζ),
+    /// the map and |S(f)| are taken from here instead of being recomputed every frame.
+    static ANALYSIS: RefCell<Option<(AnalysisKey, Analysis)>> = const { RefCell::new(None) };
+}
+
+/// The designs and their analyses for a frame, from [`ANALYSIS`] when nothing they depend on
+/// changed. Errors carry the same fields as when computed directly (they are never cached).
+#[allow(clippy::too_many_arguments)]
+fn analysis(
+    specs: &[ShaperSpec],
+    labels: &[String],
+    mode_specs: &[ModeSpec],
+    modes: &[Mode],
+    view: &PlaygroundView,
+    options: &SensitivityOptions,
+    damping_to: f64,
+    spectrum_options: &SpectrumOptions,
+    charts: [bool; 3],
+) -> Result<Analysis, JsValue> {
+    let key = AnalysisKey {
+        specs: specs.to_vec(),
+        modes: mode_specs.to_vec(),
+        numbers: [
+            view.vtol.to_bits(),
+            view.scv.to_bits(),
+            options.from_hz.to_bits(),
+            options.to_hz.to_bits(),
+            options.points as u64,
+            damping_to.to_bits(),
+            view.damping_points as u64,
+            view.map_shaper as u64,
+            view.map_frequency_points as u64,
+            view.map_damping_points as u64,
+            spectrum_options.points as u64,
+        ],
+        charts,
+    };
+    let cached = ANALYSIS.with_borrow(|c| {
+        c.as_ref()
+            .filter(|(k, _)| *k == key)
+            .map(|(_, a)| a.clone())
+    });
+    if let Some(a) = cached {
+        return Ok(a);
+    }
+    let in_view = |e: Error| js_error(e.within("view"));
+    let mut results = Vec::with_capacity(specs.len());
+    let mut shapers = Vec::with_capacity(specs.len());
+    for (k, spec) in specs.iter().enumerate() {
+        let at = |e: Error| js_error(e.within(&format!("shapers[{k}]")));
+        let shaper = design::design_for(spec, modes).map_err(at)?;
+        let curve = vibration::sensitivity(&shaper, options).map_err(in_view)?;
+        let insensitivity = modes
+            .iter()
+            .map(|m| vibration::insensitivity(&shaper, m, view.vtol))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(in_view)?;
+        let klipper = match shaper.centroid_delay() {
+            Some(_) => Some(crate::smoothing::klipper_figures(&shaper, view.scv).map_err(in_view)?),
+            None => None,
+        };
+        results.push(ShaperResult {
+            label: labels[k].clone(),
+            family: spec.name(),
+            shaper: shaper.to_data(),
+            sensitivity: curve,
+            insensitivity,
+            residual_at_modes: modes
+                .iter()
+                .map(|m| vibration::residual_vibration(&shaper, m))
+                .collect(),
+            centroid_delay: shaper.centroid_delay(),
+            klipper,
+            simulation: None,
+        });
+        shapers.push(shaper);
+    }
+    let [damping_chart, map_chart, spectrum_chart] = charts;
+    let damping_curves = match damping_chart {
+        true => Some(
+            shapers
+                .iter()
+                .map(|s| {
+                    vibration::damping_sensitivity(
+                        s,
+                        &vibration::DampingSensitivityOptions {
+                            frequency_hz: modes[0].frequency_hz(),
+                            from_damping: 0.0,
+                            to_damping: damping_to,
+                            points: view.damping_points,
+                        },
+                    )
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(in_view)?,
+        ),
+        false => None,
+    };
+    let map = match map_chart {
+        true => Some(
+            vibration::sensitivity_map(
+                &shapers[view.map_shaper],
+                &vibration::SensitivityMapOptions {
+                    from_hz: options.from_hz,
+                    to_hz: options.to_hz,
+                    frequency_points: view.map_frequency_points,
+                    damping_from: 0.0,
+                    damping_to,
+                    damping_points: view.map_damping_points,
+                },
+            )
+            .map_err(in_view)?,
+        ),
+        false => None,
+    };
+    let impulse_spectra = match spectrum_chart {
+        true => Some(
+            specs
+                .iter()
+                .zip(&shapers)
+                .map(|(spec, shaper)| {
+                    let own_move =
+                        matches!(spec, ShaperSpec::Bangbang { .. } | ShaperSpec::Onoff { .. });
+                    if own_move {
+                        return Ok(None);
+                    }
+                    crate::spectrum::impulse_spectrum(shaper, spectrum_options)
+                        .map(|s| Some(s.magnitude))
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(in_view)?,
+        ),
+        false => None,
+    };
+    let a = Analysis {
+        shapers,
+        results,
+        damping_curves,
+        map,
+        impulse_spectra,
+    };
+    ANALYSIS.with_borrow_mut(|c| *c = Some((key, a.clone())));
+    Ok(a)
+}
+
 /// `renderPlayground(state, canvases)`: everything one frame of the page needs, in one call.
 ///
 /// `state = { modes, shapers: [{ family, …parameters }] (1 … 4; or `shaper` for one),
@@ -579,43 +754,6 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
         points: view.points,
         damping: modes[0].damping(),
     };
-    let labels = labels(&specs);
-    let mut results = Vec::with_capacity(specs.len());
-    let mut shapers = Vec::with_capacity(specs.len());
-    for (k, spec) in specs.iter().enumerate() {
-        let at = |e: Error| js_error(e.within(&format!("shapers[{k}]")));
-        let shaper = design::design_for(spec, &modes).map_err(at)?;
-        let curve =
-            vibration::sensitivity(&shaper, &options).map_err(|e| js_error(e.within("view")))?;
-        let insensitivity = modes
-            .iter()
-            .map(|m| vibration::insensitivity(&shaper, m, view.vtol))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| js_error(e.within("view")))?;
-        let klipper = match shaper.centroid_delay() {
-            Some(_) => Some(
-                crate::smoothing::klipper_figures(&shaper, view.scv)
-                    .map_err(|e| js_error(e.within("view")))?,
-            ),
-            None => None,
-        };
-        results.push(ShaperResult {
-            label: labels[k].clone(),
-            family: spec.name(),
-            shaper: shaper.to_data(),
-            sensitivity: curve,
-            insensitivity,
-            residual_at_modes: modes
-                .iter()
-                .map(|m| vibration::residual_vibration(&shaper, m))
-                .collect(),
-            centroid_delay: shaper.centroid_delay(),
-            klipper,
-            simulation: None,
-        });
-        shapers.push(shaper);
-    }
-
     // The view's analysis settings.
     let z_max = modes.iter().map(Mode::damping).fold(0.0_f64, f64::max);
     let damping_to = match view.damping_to {
@@ -643,6 +781,35 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
     count_in("view.dampingPoints", view.damping_points, 2, 5000).map_err(js_error)?;
     count_in("view.spectrumPoints", view.spectrum_points, 2, 5000).map_err(js_error)?;
     let samples = count_in("view.samples", view.samples, 50, 20_000).map_err(js_error)?;
+    let spectrum_options = SpectrumOptions {
+        from_hz: options.from_hz,
+        to_hz: options.to_hz,
+        points: view.spectrum_points,
+        signal: SpectrumSignal::Velocity,
+    };
+    let labels = labels(&specs);
+    let charts = [
+        canvas(&canvases, "damping").is_some(),
+        canvas(&canvases, "map").is_some(),
+        canvas(&canvases, "spectrum").is_some(),
+    ];
+    let Analysis {
+        shapers,
+        mut results,
+        damping_curves,
+        map,
+        impulse_spectra,
+    } = analysis(
+        &specs,
+        &labels,
+        &state.modes,
+        &modes,
+        view,
+        &options,
+        damping_to,
+        &spectrum_options,
+        charts,
+    )?;
 
     // The simulated move on the mismatched plant.
     let plant = view_plant(&modes, view).map_err(js_error)?;
@@ -695,77 +862,27 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
         },
     };
     let backend = |key: &str| canvas(&canvases, key).and_then(Canvas::new);
-    // Curves drawn only when their canvas is given, but computed before anything is drawn.
-    let damping_curves = match canvas(&canvases, "damping") {
-        Some(_) => Some(
-            shapers
-                .iter()
-                .map(|s| {
-                    vibration::damping_sensitivity(
-                        s,
-                        &vibration::DampingSensitivityOptions {
-                            frequency_hz: modes[0].frequency_hz(),
-                            from_damping: 0.0,
-                            to_damping: damping_to,
-                            points: view.damping_points,
-                        },
-                    )
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| js_error(e.within("view")))?,
-        ),
-        None => None,
-    };
-    let map = match canvas(&canvases, "map") {
-        Some(_) => Some(
-            vibration::sensitivity_map(
-                &shapers[view.map_shaper],
-                &vibration::SensitivityMapOptions {
-                    from_hz: options.from_hz,
-                    to_hz: options.to_hz,
-                    frequency_points: view.map_frequency_points,
-                    damping_from: 0.0,
-                    damping_to,
-                    damping_points: view.map_damping_points,
-                },
-            )
-            .map_err(|e| js_error(e.within("view")))?,
-        ),
-        None => None,
-    };
-    let spectra = match canvas(&canvases, "spectrum") {
-        Some(_) => {
-            let so = SpectrumOptions {
-                from_hz: options.from_hz,
-                to_hz: options.to_hz,
-                points: view.spectrum_points,
-                signal: SpectrumSignal::Velocity,
-            };
+    let spectra = match &impulse_spectra {
+        Some(impulse_spectra) => {
             let one = |c: &Command| {
-                crate::spectrum::command_spectrum(c, &so).map_err(|e| js_error(e.within("view")))
+                crate::spectrum::command_spectrum(c, &spectrum_options)
+                    .map_err(|e| js_error(e.within("view")))
             };
             let unshaped = one(&command)?;
             // A piecewise command shaped by a shaper is their convolution, so its transform is
             // the product: |U_s(f)| = |S(f)|·|U(f)| exactly, at O(impulses) per frequency
             // instead of O(knots). Force-profile moves and sampled commands (shaped by the
             // streaming filter) are transformed directly.
-            let shaped = specs
+            let shaped = impulse_spectra
                 .iter()
-                .zip(&shapers)
                 .zip(&commands)
-                .map(|((spec, shaper), c)| {
-                    let own_move =
-                        matches!(spec, ShaperSpec::Bangbang { .. } | ShaperSpec::Onoff { .. });
-                    if own_move || !matches!(command, Command::Piecewise(_)) {
-                        return one(c).map(|s| s.magnitude);
-                    }
-                    let s = crate::spectrum::impulse_spectrum(shaper, &so)
-                        .map_err(|e| js_error(e.within("view")))?;
-                    Ok(s.magnitude
+                .map(|(s, c)| match s {
+                    Some(s) if matches!(command, Command::Piecewise(_)) => Ok(s
                         .iter()
                         .zip(&unshaped.magnitude)
                         .map(|(a, b)| a * b)
-                        .collect())
+                        .collect()),
+                    _ => one(c).map(|s| s.magnitude),
                 })
                 .collect::<Result<Vec<Vec<f64>>, JsValue>>()?;
             Some((unshaped, shaped))

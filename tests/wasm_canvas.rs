@@ -211,3 +211,94 @@ fn render_playground_draws_every_chart_and_the_mismatch_moves_the_response() {
         assert_eq!(&pixels(c), before, "{k} kept after the error");
     }
 }
+
+/// `renderPlayground` keeps the last frame's designs and analyses and reuses them while only
+/// the simulation's inputs change. Through a sequence of edits — mismatch, Vtol, square corner
+/// velocity, a mode's frequency, the family, the mismatch again — every frame's shaper,
+/// I(Vtol) and Klipper smoothing equal what `design`, `insensitivity` and `klipperFigures`
+/// compute for that frame's state from scratch (so a stale analysis would fail here), and the
+/// mismatch edits change the simulated residual but not the analysis.
+#[wasm_bindgen_test]
+fn analyses_kept_between_frames_follow_every_input_they_depend_on() {
+    let canvases = js_sys::Object::new();
+    for key in ["damping", "map", "spectrum"] {
+        Reflect::set(&canvases, &key.into(), &canvas(320, 200)).unwrap();
+    }
+    let get = |v: &JsValue, path: &[&str]| {
+        path.iter()
+            .fold(v.clone(), |v, k| Reflect::get(&v, &(*k).into()).unwrap())
+    };
+    let edits: [(f64, f64, f64, &str, f64); 7] = [
+        (2.0, 0.05, 5.0, "zvd", 1.0),
+        (2.0, 0.05, 5.0, "zvd", 1.2),
+        (2.0, 0.10, 5.0, "zvd", 1.2),
+        (2.0, 0.10, 400.0, "zvd", 1.2),
+        (2.5, 0.10, 400.0, "zvd", 1.2),
+        (2.5, 0.10, 400.0, "ei", 1.2),
+        (2.5, 0.10, 400.0, "ei", 0.9),
+    ];
+    let mut last_residual = f64::NAN;
+    let mut last_analysis = String::new();
+    for (i, &(f, vtol, scv, family, mismatch)) in edits.iter().enumerate() {
+        let state = JSON::parse(&format!(
+            r#"{{"modes":[{{"frequencyHz":{f},"damping":0.03}}],"shapers":[{{"family":"{family}"}}],
+                "view":{{"vtol":{vtol},"scv":{scv},"mismatch":{mismatch},
+                         "command":{{"kind":"trapezoid","distance":1,"maxVelocity":0.8,"maxAcceleration":8}}}}}}"#
+        ))
+        .unwrap();
+        let out = wasm::render_playground(state, canvases.clone().into()).unwrap();
+        let result = js_sys::Array::from(&get(&out, &["results"])).get(0);
+        let mode = JSON::parse(&format!(r#"{{"frequencyHz":{f},"damping":0.03}}"#)).unwrap();
+        let spec = JSON::parse(&format!(
+            r#"{{"family":"{family}","modes":[{{"frequencyHz":{f},"damping":0.03}}]}}"#
+        ))
+        .unwrap();
+        let fresh = wasm::design(spec).unwrap();
+        assert_eq!(
+            JSON::stringify(&get(&result, &["shaper"])).unwrap(),
+            JSON::stringify(&fresh).unwrap(),
+            "edit {i}: shaper"
+        );
+        let width = get(&result, &["insensitivity"]);
+        let width = get(&js_sys::Array::from(&width).get(0), &["width"])
+            .as_f64()
+            .unwrap();
+        let expect = get(
+            &wasm::insensitivity(fresh.clone(), mode, vtol).unwrap(),
+            &["width"],
+        );
+        assert_eq!(width, expect.as_f64().unwrap(), "edit {i}: I(Vtol)");
+        let options = JSON::parse(&format!(r#"{{"scv":{scv}}}"#)).unwrap();
+        let klipper = wasm::klipper_figures(fresh, options).unwrap();
+        assert_eq!(
+            get(&result, &["klipper", "smoothing"]).as_f64(),
+            get(&klipper, &["smoothing"]).as_f64(),
+            "edit {i}: Klipper smoothing"
+        );
+        let residual = get(&result, &["simulation", "residualVibrationPercent"])
+            .as_f64()
+            .unwrap();
+        let analysis = format!(
+            "{} {width} {:?}",
+            JSON::stringify(&get(&result, &["shaper"])).unwrap(),
+            get(&result, &["klipper", "smoothing"]).as_f64()
+        );
+        if i > 0 && mismatch != edits[i - 1].4 {
+            assert_ne!(
+                residual, last_residual,
+                "edit {i}: the simulation follows r"
+            );
+            assert_eq!(
+                analysis, last_analysis,
+                "edit {i}: a mismatch edit keeps the analysis"
+            );
+        } else if i > 0 {
+            assert_ne!(
+                analysis, last_analysis,
+                "edit {i}: the analysis follows the edit"
+            );
+        }
+        last_residual = residual;
+        last_analysis = analysis;
+    }
+}
