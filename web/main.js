@@ -235,6 +235,9 @@ function showError(error) {
 }
 
 // ---------- results ----------
+/** The impulses each impulse table shows, as JSON (by table body). */
+const impulseKeys = new WeakMap();
+
 function showResults(result, st) {
   const { results } = result;
   const labels = JSON.stringify(results.map((r) => r.label));
@@ -264,8 +267,14 @@ function showResults(result, st) {
     el('caption', {}, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), r.label),
     el('thead', {}, el('tr', {}, el('th', { scope: 'col' }, '#'), el('th', { scope: 'col' }, 'time (s)'), el('th', { scope: 'col' }, 'amplitude'))),
     el('tbody', {}))));
-  results.forEach((r, k) => syncRows($(`impulses-${k}`).tBodies[0],
-    r.shaper.impulses.map((imp, i) => [String(i + 1), fmt(imp.time, 10), fmt(imp.amplitude, 10)]), 0));
+  results.forEach((r, k) => {
+    // Unchanged impulses (a mismatch or command edit) are not re-read cell by cell.
+    const body = $(`impulses-${k}`).tBodies[0];
+    const key = JSON.stringify(r.shaper.impulses);
+    if (impulseKeys.get(body) === key) return;
+    syncRows(body, r.shaper.impulses.map((imp, i) => [String(i + 1), fmt(imp.time, 10), fmt(imp.amplitude, 10)]), 0);
+    impulseKeys.set(body, key);
+  });
 
   const sel = $('export-shaper');
   const keep = sel.value;

@@ -65,23 +65,25 @@ pub fn contour_segments(map: &SensitivityMap, level: f64) -> Vec<[(f64, f64); 2]
     if map.vibration.len() != f.len() * z.len() {
         return segments;
     }
-    let at = |k: usize, j: usize| map.vibration.get(k * f.len() + j).copied();
+    let nf = f.len();
+    let v = &map.vibration;
     for k in 0..z.len().saturating_sub(1) {
-        for j in 0..f.len().saturating_sub(1) {
-            // Corners counter-clockwise from bottom-left: (f, ζ, V).
-            let corners = [(j, k), (j + 1, k), (j + 1, k + 1), (j, k + 1)].map(|(j, k)| {
-                (
-                    f.get(j).copied().unwrap_or(0.0),
-                    z.get(k).copied().unwrap_or(0.0),
-                    at(k, j).unwrap_or(f64::NAN),
-                )
-            });
-            if corners.iter().any(|c| !c.2.is_finite()) {
+        for j in 0..nf.saturating_sub(1) {
+            // Corners counter-clockwise from bottom-left: grid indices (j, k).
+            // (In range: the length was checked above.)
+            let at = [(j, k), (j + 1, k), (j + 1, k + 1), (j, k + 1)];
+            let i = k * nf + j;
+            let values = [v[i], v[i + 1], v[i + nf + 1], v[i + nf]];
+            if values.iter().any(|x| !x.is_finite()) {
                 continue;
             }
-            let above = corners.iter().filter(|c| c.2 > level).count();
+            let above = values.iter().filter(|&&x| x > level).count();
             if above == 0 || above == 4 {
                 continue; // the level does not cross this cell (most cells)
+            }
+            let mut corners = [(0.0, 0.0, 0.0); 4];
+            for ((c, &(j, k)), &value) in corners.iter_mut().zip(&at).zip(&values) {
+                *c = (f[j], z[k], value);
             }
             // Crossing on edge e (from corner e to corner e+1), if the level separates them.
             let crossing = |e: usize| {
