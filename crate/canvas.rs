@@ -11,7 +11,8 @@
 //! here as `CanvasBackend` draws them, except that the stroke style, line width, fill style,
 //! font and text alignment are written to the context only when they differ from what was last
 //! written: each write formats a CSS string that the browser then parses. Consecutive lines
-//! of one style become one path with one `stroke`, and text sizes are remembered across frames
+//! (or circles) of one style become one path with one `stroke` (or `fill`: overlapping
+//! translucent circles are then filled once, not twice), and text sizes are remembered across frames
 //! (the same tick labels come back on every edit). Bitmaps (the sensitivity map) are written
 //! with one `putImageData`. Everything else is delegated to
 //! `CanvasBackend`, after which the remembered state is forgotten (it may have changed it).
@@ -35,8 +36,20 @@ struct ContextState {
     fill: Option<Rgba>,
     font: Option<String>,
     align: Option<(&'static str, &'static str)>,
-    /// Lines added to the current path and not yet stroked (in the stroke style above).
-    open_lines: bool,
+    /// What the current path holds that is not yet stroked or filled (in the style above).
+    open: Open,
+}
+
+/// The shapes collected in the current path, drawn by one `stroke` or `fill` when something
+/// else is drawn ([`Canvas::flush`]).
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+enum Open {
+    #[default]
+    Nothing,
+    /// Lines, in the stroke style.
+    Lines,
+    /// Circles, filled in the fill style (`true`) or outlined in the stroke style.
+    Circles(bool),
 }
 
 thread_local! {
@@ -144,13 +157,36 @@ impl Canvas {
         }
     }
 
-    /// Strokes the lines [`DrawingBackend::draw_line`] has collected, if any. Every drawing
-    /// operation other than a line calls this first, so the drawing order is kept.
+    /// Strokes or fills the shapes collected in the current path, if any. Every drawing
+    /// operation that does not add to the path calls this first, so the drawing order is kept.
     fn flush(&self) {
         let mut st = self.state.borrow_mut();
-        if st.open_lines {
-            self.context.stroke();
-            st.open_lines = false;
+        match std::mem::take(&mut st.open) {
+            Open::Nothing => {}
+            Open::Lines | Open::Circles(false) => self.context.stroke(),
+            Open::Circles(true) => self.context.fill(),
+        }
+    }
+
+    /// Makes the current path collect `open` shapes: if it already does in this style,
+    /// nothing; otherwise the collected shapes are drawn, the style set and a path begun.
+    fn collect<S: BackendStyle>(&self, open: Open, style: &S) {
+        let same = {
+            let st = self.state.borrow();
+            st.open == open
+                && match open {
+                    Open::Circles(true) => st.fill == Some(rgba(style.color())),
+                    _ => st.stroke == Some((rgba(style.color()), style.stroke_width())),
+                }
+        };
+        if !same {
+            self.flush();
+            match open {
+                Open::Circles(true) => self.fill_style(style.color()),
+                _ => self.line_style(style),
+            }
+            self.context.begin_path();
+            self.state.borrow_mut().open = open;
         }
     }
 
@@ -203,19 +239,9 @@ impl DrawingBackend for Canvas {
         // Consecutive lines of one style (a chart's grid lines, its tick marks) are one path
         // and one `stroke`: each stroke is a separate draw the browser records and rasterises.
         let (a, b) = fine_lines(from, to);
-        let want = (rgba(style.color()), style.stroke_width());
-        let same = {
-            let st = self.state.borrow();
-            st.open_lines && st.stroke == Some(want)
-        };
-        if !same {
-            self.flush();
-            self.line_style(style);
-            self.context.begin_path();
-        }
+        self.collect(Open::Lines, style);
         self.context.move_to(a.0, a.1);
         self.context.line_to(b.0, b.1);
-        self.state.borrow_mut().open_lines = true;
         Ok(())
     }
 
@@ -274,9 +300,25 @@ impl DrawingBackend for Canvas {
         style: &S,
         fill: bool,
     ) -> Result<(), Failure> {
-        self.flush();
-        self.forget();
-        self.inner.draw_circle(center, radius, style, fill)
+        // Markers of one style (an impulse chart's stem heads) are one path, as lines are.
+        if style.color().alpha == 0.0 {
+            return Ok(());
+        }
+        self.collect(Open::Circles(fill), style);
+        let (x, y, r) = (f64::from(center.0), f64::from(center.1), f64::from(radius));
+        self.context.move_to(x + r, y);
+        if self
+            .context
+            .arc(x, y, r, 0.0, std::f64::consts::TAU)
+            .is_err()
+        {
+            // Never seen (a negative radius): draw what was collected and let CanvasBackend
+            // report it.
+            self.flush();
+            self.forget();
+            return self.inner.draw_circle(center, radius, style, fill);
+        }
+        Ok(())
     }
 
     fn fill_polygon<S: BackendStyle, I: IntoIterator<Item = BackendCoord>>(
