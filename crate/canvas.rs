@@ -11,12 +11,11 @@
 //! here as `CanvasBackend` draws them, except that the stroke style, line width, fill style,
 //! font and text alignment are written to the context only when they differ from what was last
 //! written: each write formats a CSS string that the browser then parses. Consecutive lines
-//! (or circles) of one style become one path with one `stroke` (or `fill`: overlapping
-//! translucent circles are then filled once, not twice), and text sizes are remembered across frames
-//! (the same tick labels come back on every edit). Bitmaps (the sensitivity map) are written
-//! with one `putImageData`. Everything else is delegated to
-//! `CanvasBackend`, after which the remembered state is forgotten (it may have changed it).
-//! Compiled only for wasm32.
+//! (or circles) of one style become one path with one `stroke` (or `fill`; overlapping
+//! translucent circles are then filled once, not twice). Text sizes are remembered across
+//! frames (the same tick labels come back on every edit). Bitmaps (the sensitivity map) are
+//! written with one `putImageData`. Everything else is delegated to `CanvasBackend`, after
+//! which the remembered state is forgotten (it may have changed it). Compiled only for wasm32.
 
 use plotters::prelude::DrawingBackend;
 use plotters_backend::text_anchor::{HPos, VPos};
@@ -197,7 +196,7 @@ impl Canvas {
 }
 
 impl Drop for Canvas {
-    /// Strokes the lines still collected when the chart is done with the backend.
+    /// Draws the shapes still collected when the chart is done with the backend.
     fn drop(&mut self) {
         self.flush();
     }
