@@ -208,7 +208,8 @@ const SCAN_CHUNK: usize = 256;
 
 /// Frequency insensitivity I(Vtol) of `shaper` at `mode` (damping held at the mode's): the
 /// band edges are bracketed by a scan fine enough for the shaper's duration and refined to
-/// machine precision (safeguarded false position, [`refine_crossing`]).
+/// machine precision by the ITP method (Oliveira & Takahashi 2020: about 10 evaluations of
+/// eq. 11 per edge, never more than bisection + 3).
 pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensitivity> {
     tolerable_vibration(vtol)?;
     let f_m = mode.frequency_hz();
@@ -264,8 +265,9 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
 }
 
 /// Walks from `start` (where `excess ≤ 0`) towards `limit` in steps of `step` and returns the
-/// first crossing of `excess` above 0, refined by [`refine_crossing`], or `limit` if there is none. At
-/// most ~`max_steps` evaluations whatever the inputs (the step is coarsened beyond that).
+/// first crossing of `excess` above 0, refined by [`refine_crossing`], or `limit` if there is
+/// none. At most ~`max_steps` evaluations whatever the inputs (the step is coarsened beyond
+/// that).
 fn band_edge(
     excess: &impl Fn(f64) -> f64,
     start: f64,
@@ -560,7 +562,7 @@ pub const MAX_BAND_DAMPING: f64 = 0.999;
 /// Damping insensitivity of `shaper` at `mode` (frequency held at the mode's): the band of ζ
 /// where V(ω_m, ζ) ≤ Vtol around the mode's damping. The edges are bracketed by a scan with step
 /// min(10⁻³, 0.1/(ω_m t_n)) in ζ (V's phase ω√(1−ζ²)tᵢ and decay ζω(t_n − tᵢ) change by at most
-/// ~ω t_n per unit of ζ away from ζ → 1) and refined by [`refine_crossing`].
+/// ~ω t_n per unit of ζ away from ζ → 1) and refined by the ITP method, as in [`insensitivity`].
 pub fn damping_insensitivity(
     shaper: &Shaper,
     mode: &Mode,

@@ -261,7 +261,7 @@ impl Lti {
     /// Three passes, each a tight loop: (1) the command's derivatives w at every sample and the
     /// state jumps of the knots (a knot between two samples contributes e^{M(t − τ)}(impulse,
     /// jumps) at the next sample); (2) each independent block of states marched over all samples,
-    /// x ← Φx + Γw, the modes' 2 × 2 blocks [`LANES`] at a time with their input terms formed
+    /// x ← Φx + Γw, the modes' 2 × 2 blocks `LANES` (4) at a time with their input terms formed
     /// before the recurrence; (3) each output row as a sum of whole columns (vectorised).
     pub fn respond(
         &self,
