@@ -48,6 +48,9 @@ layer() {
 layer fmt cargo fmt --check
 layer clippy cargo clippy --all-targets -- -D warnings
 layer clippy-wasm cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
+# The public API's rustdoc builds without warnings (broken or private intra-doc links).
+layer doc env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib
+layer doc-wasm env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib --target wasm32-unknown-unknown
 # Includes the reliability layer's property tests and fuzz replay (issue 6). Every loop in the
 # library is bounded; the timeout turns a hang into a failure instead of a stalled CI.
 layer native timeout 2400 cargo test -- --skip quick_grid
