@@ -27,9 +27,24 @@ pub struct Impulse {
 
 /// A validated impulse sequence: non-empty, finite, sorted by strictly increasing time, the
 /// first impulse at t = 0.
-#[derive(Debug, Clone, PartialEq)]
+///
+/// A shaper made by [`Shaper::convolve`] also remembers its factors when they are shorter in
+/// total than the product: the transform of a convolution is the product of the transforms, so
+/// V(ω, ζ) of the product is the product of the factors' V, and the analyses
+/// ([`crate::vibration`]) evaluate Σ nₖ impulses instead of Π nₖ. Two shapers are equal when
+/// their impulses are; the factors are not part of the value.
+#[derive(Debug, Clone)]
 pub struct Shaper {
     impulses: Vec<Impulse>,
+    /// The convolution factors' impulses (each a valid shaper's), or empty when the shaper is
+    /// evaluated from its own impulses.
+    factors: Vec<Vec<Impulse>>,
+}
+
+impl PartialEq for Shaper {
+    fn eq(&self, other: &Self) -> bool {
+        self.impulses == other.impulses
+    }
 }
 
 /// The wire form of a shaper: `{ impulses: [{ time, amplitude }], duration }`. `duration` is
@@ -41,6 +56,11 @@ pub struct ShaperData {
     /// Time of the last impulse in seconds.
     #[serde(default)]
     pub duration: f64,
+}
+
+/// Whether `impulses` is the identity (one unit impulse), which a convolution leaves out.
+fn is_unit(impulses: &[Impulse]) -> bool {
+    matches!(impulses, [only] if only.amplitude == 1.0)
 }
 
 /// Impulses closer than this (relative to the shaper's duration) are merged into one.
@@ -134,7 +154,10 @@ impl Shaper {
         for imp in &mut merged {
             imp.time -= first;
         }
-        Ok(Shaper { impulses: merged })
+        Ok(Shaper {
+            impulses: merged,
+            factors: Vec::new(),
+        })
     }
 
     /// Builds a shaper from its wire form.
@@ -157,6 +180,7 @@ impl Shaper {
                 time: 0.0,
                 amplitude: 1.0,
             }],
+            factors: Vec::new(),
         }
     }
 
@@ -222,7 +246,28 @@ impl Shaper {
                 });
             }
         }
-        Shaper::new(out)
+        let mut shaper = Shaper::new(out)?;
+        // V of the product is the product of the factors' V (the transform of a convolution is
+        // the product of the transforms; merging coincident impulses and dropping cancelled
+        // ones change neither). Keep the factors when evaluating them is cheaper.
+        let factors: Vec<Vec<Impulse>> = self
+            .factors()
+            .chain(other.factors())
+            .filter(|f| !is_unit(f))
+            .map(<[Impulse]>::to_vec)
+            .collect();
+        if factors.len() > 1 && factors.iter().map(Vec::len).sum::<usize>() < shaper.len() {
+            shaper.factors = factors;
+        }
+        Ok(shaper)
+    }
+
+    /// The impulse sequences whose residual vibrations multiply to this shaper's: its
+    /// convolution factors (see [`Shaper`]), or its own impulses alone.
+    pub fn factors(&self) -> impl Iterator<Item = &[Impulse]> {
+        let own = self.factors.is_empty().then_some(self.impulses.as_slice());
+        own.into_iter()
+            .chain(self.factors.iter().map(Vec::as_slice))
     }
 
     /// The same shaper with all times multiplied by `factor` (> 0): a shaper for a mode at

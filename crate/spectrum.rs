@@ -18,7 +18,7 @@
 use crate::command::{taylor_shift, Command, Cursor, Piecewise, Sampled};
 use crate::error::{count, Error, Result};
 use crate::shaper::Shaper;
-use crate::vibration::{frequency_range, linspace, vibration_on_grid};
+use crate::vibration::{frequency_range, linspace, shaper_on_grid};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -94,20 +94,14 @@ fn grid(options: &SpectrumOptions) -> Result<Vec<f64>> {
 ///
 /// This is V(f, ζ = 0) of Singhose 2009 eq. 11, √(C² + S²) with no damping factor (the sign
 /// of the phase does not change the modulus), so it is evaluated on the grid by
-/// [`vibration_on_grid`]'s recurrence: a complex multiplication per impulse and frequency
-/// instead of a sine and a cosine.
+/// [`vibration_on_grid`](crate::vibration::vibration_on_grid)'s recurrence: a complex
+/// multiplication per impulse and frequency instead of a sine and a cosine (per impulse of each
+/// convolution factor, see [`Shaper`]).
 pub fn impulse_spectrum(shaper: &Shaper, options: &SpectrumOptions) -> Result<Spectrum> {
     let f = grid(options)?;
     let step = (options.to_hz - options.from_hz) / (options.points - 1) as f64;
     let mut magnitude = Vec::with_capacity(f.len());
-    vibration_on_grid(
-        shaper.impulses(),
-        options.from_hz,
-        step,
-        f.len(),
-        0.0,
-        &mut magnitude,
-    );
+    shaper_on_grid(shaper, options.from_hz, step, f.len(), 0.0, &mut magnitude);
     Ok(Spectrum {
         frequency_hz: f,
         magnitude,

@@ -4,6 +4,11 @@
 //! [`vibration_rad`] is the one implementation of Singhose 2009 eq. 11; every curve, chart,
 //! metric and design check calls it. The one fast path, [`sensitivity_map`], evaluates the same
 //! per-impulse term on a grid by recurrence and is tested point by point against it.
+//!
+//! A shaper that is a convolution (the multi-mode designs) is analysed through its factors: V of
+//! a convolution is the product of the factors' V, so a curve of a three-mode ZVD costs 9
+//! impulse terms per point instead of 27 (see [`Shaper`]; tested against the impulses).
+//! Design checks still evaluate the impulses themselves.
 
 use crate::error::{count, finite, positive, Error, Result};
 use crate::mode::Mode;
@@ -77,7 +82,17 @@ fn term(amplitude: f64, time: f64, t_n: f64, omega: f64, zeta: f64, damped: f64)
 
 /// Residual vibration V of `shaper` on `mode` (fraction: 0 = none, 1 = as much as unshaped).
 pub fn residual_vibration(shaper: &Shaper, mode: &Mode) -> f64 {
-    vibration_rad(shaper.impulses(), mode.omega_rad_s(), mode.damping())
+    shaper_vibration(shaper, mode.omega_rad_s(), mode.damping())
+}
+
+/// V of `shaper` at (`omega`, `zeta`): [`vibration_rad`] of its impulses, or the product of its
+/// convolution factors' (the same number to rounding, for Σ nₖ instead of Π nₖ terms; see
+/// [`Shaper`]).
+pub(crate) fn shaper_vibration(shaper: &Shaper, omega: f64, zeta: f64) -> f64 {
+    shaper
+        .factors()
+        .map(|f| vibration_rad(f, omega, zeta))
+        .product()
 }
 
 /// Options of a sensitivity curve V(f) at a fixed damping ratio.
@@ -167,8 +182,8 @@ pub fn sensitivity(shaper: &Shaper, options: &SensitivityOptions) -> Result<Sens
     let frequency_hz: Vec<f64> = linspace(options.from_hz, options.to_hz, options.points).collect();
     let step = (options.to_hz - options.from_hz) / (options.points - 1) as f64;
     let mut vibration = Vec::with_capacity(options.points);
-    vibration_on_grid(
-        shaper.impulses(),
+    shaper_on_grid(
+        shaper,
         options.from_hz,
         step,
         options.points,
@@ -216,7 +231,7 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
     let zeta = mode.damping();
     let threshold = vtol * (1.0 + VTOL_SLACK) + 1e-14;
     let excess =
-        |f: f64| vibration_rad(shaper.impulses(), 2.0 * std::f64::consts::PI * f, zeta) - threshold;
+        |f: f64| shaper_vibration(shaper, 2.0 * std::f64::consts::PI * f, zeta) - threshold;
     if excess(f_m) > 0.0 {
         return Ok(Insensitivity {
             low_hz: f_m,
@@ -236,6 +251,7 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
             .max(work_step(span))
             .max(span / 2e6);
         let h = direction * step;
+        let mut rows = Rows::new(shaper, h);
         let mut inside = f_m;
         loop {
             let remaining = ((limit - inside) / h).floor().max(0.0) as usize;
@@ -247,7 +263,7 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
                     limit
                 };
             }
-            vibration_on_grid(shaper.impulses(), inside + h, h, n, zeta, &mut values);
+            rows.fill(inside + h, zeta, &mut values, n);
             if let Some(k) = values.iter().position(|&v| v > threshold) {
                 let outside = inside + h * (k + 1) as f64;
                 return refine_crossing(&excess, inside + h * k as f64, outside);
@@ -395,6 +411,19 @@ pub fn vibration_on_grid(
     RowEvaluator::new(impulses, step_hz).fill(from_hz, zeta, out);
 }
 
+/// [`vibration_on_grid`] for a shaper: its impulses, or the product of its convolution
+/// factors' rows (see [`Shaper`]).
+pub(crate) fn shaper_on_grid(
+    shaper: &Shaper,
+    from_hz: f64,
+    step_hz: f64,
+    n: usize,
+    zeta: f64,
+    out: &mut Vec<f64>,
+) {
+    Rows::new(shaper, step_hz).fill(from_hz, zeta, out, n);
+}
+
 /// The complex residual-vibration phasor of an impulse sequence and its derivatives, for the
 /// designs that solve for impulses with Newton's method (EI with damping, unity-magnitude,
 /// bang-bang).
@@ -536,7 +565,7 @@ pub fn damping_sensitivity(
         linspace(options.from_damping, options.to_damping, options.points).collect();
     let vibration = damping
         .iter()
-        .map(|&z| vibration_rad(shaper.impulses(), omega, z))
+        .map(|&z| shaper_vibration(shaper, omega, z))
         .collect();
     Ok(DampingSensitivityCurve { damping, vibration })
 }
@@ -572,7 +601,7 @@ pub fn damping_insensitivity(
     let omega = mode.omega_rad_s();
     let z_m = mode.damping();
     let threshold = vtol * (1.0 + VTOL_SLACK) + 1e-14;
-    let excess = |z: f64| vibration_rad(shaper.impulses(), omega, z) - threshold;
+    let excess = |z: f64| shaper_vibration(shaper, omega, z) - threshold;
     if excess(z_m) > 0.0 {
         return Ok(DampingInsensitivity {
             low_damping: z_m,
@@ -686,15 +715,57 @@ pub fn sensitivity_map(shaper: &Shaper, options: &SensitivityMapOptions) -> Resu
     let damping: Vec<f64> = linspace(options.damping_from, options.damping_to, nz).collect();
     let mut vibration = vec![0.0; nf * nz];
     let step_hz = (options.to_hz - options.from_hz) / (nf - 1) as f64;
-    let mut rows = RowEvaluator::new(shaper.impulses(), step_hz);
+    let mut rows = Rows::new(shaper, step_hz);
     for (row, &zeta) in vibration.chunks_exact_mut(nf).zip(&damping) {
-        rows.fill(options.from_hz, zeta, row);
+        rows.fill_slice(options.from_hz, zeta, row);
     }
     Ok(SensitivityMap {
         frequency_hz,
         damping,
         vibration,
     })
+}
+
+/// [`RowEvaluator`]s for each convolution factor of a shaper (see [`Shaper`]): V on a row of
+/// frequencies is the product of the factors' rows.
+struct Rows {
+    factors: Vec<RowEvaluator>,
+    scratch: Vec<f64>,
+}
+
+impl Rows {
+    fn new(shaper: &Shaper, step_hz: f64) -> Self {
+        Rows {
+            factors: shaper
+                .factors()
+                .map(|f| RowEvaluator::new(f, step_hz))
+                .collect(),
+            scratch: Vec::new(),
+        }
+    }
+
+    /// Writes V(`from_hz` + k·step, `zeta`), k = 0 … n−1, to `out` (cleared first).
+    fn fill(&mut self, from_hz: f64, zeta: f64, out: &mut Vec<f64>, n: usize) {
+        out.clear();
+        out.resize(n, 0.0);
+        self.fill_slice(from_hz, zeta, out);
+    }
+
+    /// Writes V(`from_hz` + k·step, `zeta`) into `out[k]` for every k.
+    fn fill_slice(&mut self, from_hz: f64, zeta: f64, out: &mut [f64]) {
+        let Some((first, rest)) = self.factors.split_first_mut() else {
+            return;
+        };
+        first.fill(from_hz, zeta, out);
+        for factor in rest {
+            self.scratch.clear();
+            self.scratch.resize(out.len(), 0.0);
+            factor.fill(from_hz, zeta, &mut self.scratch);
+            for (v, w) in out.iter_mut().zip(&self.scratch) {
+                *v *= w;
+            }
+        }
+    }
 }
 
 /// Frequencies advanced side by side in [`sensitivity_map`].

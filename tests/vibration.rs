@@ -224,3 +224,117 @@ fn phasor_modulus_is_v_and_its_frequency_derivatives_match_differences() {
         }
     }
 }
+
+/// A convolved shaper is analysed through its factors (V of a convolution is the product of the
+/// factors' V, the transform of a convolution being the product of the transforms): every
+/// analysis of the factored shaper must match the same impulses analysed directly. Cases: three
+/// modes of ZVD (27 impulses from 9), and 1 Hz and 2 Hz ZVD at ζ = 0 (times 0, ½, 1 s and 0, ¼,
+/// ½ s), whose sums coincide at ½ and 1 s and are merged: 7 impulses from 6.
+#[wasm_bindgen_test(unsupported = test)]
+fn convolved_shapers_analysed_by_factors_match_their_impulses() {
+    use input_shaping::design::{design_for, ShaperSpec};
+    use input_shaping::spectrum::{impulse_spectrum, SpectrumOptions};
+    use input_shaping::vibration::{
+        damping_insensitivity, damping_sensitivity, insensitivity, sensitivity_map,
+        DampingSensitivityOptions, SensitivityMapOptions,
+    };
+    let cases = [
+        vec![
+            Mode::new(1.2, 0.012).unwrap(),
+            Mode::new(3.4, 0.013).unwrap(),
+            Mode::new(7.9, 0.02).unwrap(),
+        ],
+        vec![Mode::new(1.0, 0.0).unwrap(), Mode::new(2.0, 0.0).unwrap()],
+    ];
+    for (modes, (impulses, factors)) in cases.iter().zip([(27, 3), (7, 2)]) {
+        let factored = design_for(&ShaperSpec::Zvd, modes).unwrap();
+        let direct = Shaper::new(factored.impulses().to_vec()).unwrap();
+        assert_eq!(factored.len(), impulses, "impulses after merging");
+        assert_eq!(factored.factors().count(), factors, "the factors are kept");
+        assert_eq!(direct.factors().count(), 1, "a shaper built from impulses");
+        assert_eq!(factored, direct, "equality ignores the factors");
+        let f_m = modes[0].frequency_hz();
+        for mode in modes {
+            for ratio in [0.37, 1.0, 1.13, 2.9] {
+                let m = Mode::new(mode.frequency_hz() * ratio, mode.damping() + 0.05).unwrap();
+                close(
+                    residual_vibration(&factored, &m),
+                    residual_vibration(&direct, &m),
+                    1e-13,
+                    "V",
+                );
+            }
+            let (a, b) = (
+                insensitivity(&factored, mode, 0.05).unwrap(),
+                insensitivity(&direct, mode, 0.05).unwrap(),
+            );
+            close(a.low_hz, b.low_hz, 1e-9 * f_m, "I(Vtol) low edge");
+            close(a.high_hz, b.high_hz, 1e-9 * f_m, "I(Vtol) high edge");
+            let (a, b) = (
+                damping_insensitivity(&factored, mode, 0.05).unwrap(),
+                damping_insensitivity(&direct, mode, 0.05).unwrap(),
+            );
+            close(a.low_damping, b.low_damping, 1e-9, "damping band low edge");
+            close(
+                a.high_damping,
+                b.high_damping,
+                1e-9,
+                "damping band high edge",
+            );
+            let options = DampingSensitivityOptions {
+                frequency_hz: mode.frequency_hz(),
+                from_damping: 0.0,
+                to_damping: 0.5,
+                points: 51,
+            };
+            let (a, b) = (
+                damping_sensitivity(&factored, &options).unwrap(),
+                damping_sensitivity(&direct, &options).unwrap(),
+            );
+            for (x, y) in a.vibration.iter().zip(&b.vibration) {
+                close(*x, *y, 1e-13, "V(ζ)");
+            }
+        }
+        let options = SensitivityOptions {
+            from_hz: 0.0,
+            to_hz: 4.0 * modes.last().unwrap().frequency_hz(),
+            points: 1001,
+            damping: 0.02,
+        };
+        let (a, b) = (
+            sensitivity(&factored, &options).unwrap(),
+            sensitivity(&direct, &options).unwrap(),
+        );
+        for (x, y) in a.vibration.iter().zip(&b.vibration) {
+            close(*x, *y, 1e-12, "V(f)");
+        }
+        let options = SensitivityMapOptions {
+            from_hz: 0.1,
+            to_hz: 20.0,
+            frequency_points: 300,
+            damping_from: 0.0,
+            damping_to: 0.3,
+            damping_points: 7,
+        };
+        let (a, b) = (
+            sensitivity_map(&factored, &options).unwrap(),
+            sensitivity_map(&direct, &options).unwrap(),
+        );
+        for (x, y) in a.vibration.iter().zip(&b.vibration) {
+            close(*x, *y, 1e-12, "map");
+        }
+        let options = SpectrumOptions {
+            from_hz: 0.0,
+            to_hz: 30.0,
+            points: 600,
+            signal: Default::default(),
+        };
+        let (a, b) = (
+            impulse_spectrum(&factored, &options).unwrap(),
+            impulse_spectrum(&direct, &options).unwrap(),
+        );
+        for (x, y) in a.magnitude.iter().zip(&b.magnitude) {
+            close(*x, *y, 1e-12, "|S(f)|");
+        }
+    }
+}
