@@ -36,21 +36,33 @@ const readNumber = (input) => (input.value.trim() === '' ? NaN : Number(input.va
  * Makes `section` (a thead/tbody) hold `rows` — arrays of cell texts, the first `heads` cells
  * of each row `<th scope="row">`, the rest `<td>` — reusing the rows and cells already there
  * and writing only the texts that changed. Every input event redraws the tables; rebuilding
- * them made the browser restyle and lay out hundreds of new nodes per update.
+ * them made the browser restyle and lay out hundreds of new nodes per update. The texts last
+ * written are remembered (`shownRows`), so unchanged cells are not read back from the DOM, and a
+ * changed one has its text node's data replaced rather than a new node made.
  */
+const shownRows = new WeakMap();
 function syncRows(section, rows, heads = 1) {
   while (section.rows.length > rows.length) section.deleteRow(-1);
+  const shown = shownRows.get(section) ?? [];
+  shown.length = Math.min(shown.length, section.rows.length);
   rows.forEach((cells, i) => {
     const tr = section.rows[i] ?? section.appendChild(document.createElement('tr'));
-    if (tr.cells.length !== cells.length || [...tr.cells].some((c, j) => (c.tagName === 'TH') !== (j < heads))) {
+    const last = shown[i];
+    if (!last || last.length !== cells.length || last.heads !== heads) {
       tr.replaceChildren(...cells.map((text, j) => (j < heads ? el('th', { scope: 'row' }, text) : el('td', {}, text))));
+      shown[i] = Object.assign([...cells], { heads });
       return;
     }
     cells.forEach((text, j) => {
+      if (last[j] === text) return;
       const cell = tr.cells[j];
-      if (cell.textContent !== text) cell.textContent = text;
+      const node = cell.firstChild;
+      if (node && node.nodeType === Node.TEXT_NODE && !node.nextSibling) node.data = text;
+      else cell.textContent = text;
+      last[j] = text;
     });
   });
+  shownRows.set(section, shown);
 }
 
 /** Replaces `node`'s children with `build()` only when `key` differs from the last one used. */
