@@ -13,7 +13,9 @@
 //! written: each write formats a CSS string that the browser then parses. Consecutive lines
 //! (or circles) of one style become one path with one `stroke` (or `fill`; overlapping
 //! translucent circles are then filled once, not twice). Text sizes are remembered across
-//! frames (the same tick labels come back on every edit). Bitmaps (the sensitivity map) are
+//! frames (the same tick labels come back on every edit), and so are the JS strings of texts,
+//! fonts and colours, passed to the context as they are instead of decoded from UTF-8 on every
+//! call. Bitmaps (the sensitivity map) are
 //! written with one `putImageData`. Everything else is delegated to `CanvasBackend`, after
 //! which the remembered state is forgotten (it may have changed it). Compiled only for wasm32.
 
@@ -25,8 +27,25 @@ use plotters_backend::{
 use plotters_canvas::CanvasBackend;
 use std::cell::RefCell;
 use std::collections::HashMap;
-use wasm_bindgen::{Clamped, JsCast};
+use wasm_bindgen::prelude::wasm_bindgen;
+use wasm_bindgen::{Clamped, JsCast, JsValue};
 use web_sys::{CanvasRenderingContext2d, HtmlCanvasElement, ImageData};
+
+// The 2-D context's text and style entry points taking a JS string already made (web-sys's take
+// `&str`, which the glue decodes from UTF-8 into a new JS string on every call).
+#[wasm_bindgen]
+extern "C" {
+    /// A `CanvasRenderingContext2D`, seen through the entry points below.
+    type Context2d;
+    #[wasm_bindgen(method, js_name = fillText)]
+    fn fill_text_js(this: &Context2d, text: &JsValue, x: f64, y: f64);
+    #[wasm_bindgen(method, setter = font)]
+    fn set_font_js(this: &Context2d, font: &JsValue);
+    #[wasm_bindgen(method, setter = fillStyle)]
+    fn set_fill_style_js(this: &Context2d, style: &JsValue);
+    #[wasm_bindgen(method, setter = strokeStyle)]
+    fn set_stroke_style_js(this: &Context2d, style: &JsValue);
+}
 
 /// What was last written to the context (`None`: unknown).
 #[derive(Debug, Default)]
@@ -56,6 +75,27 @@ thread_local! {
     /// and each `measureText` is a call into the browser with the text decoded into a JS
     /// string. Cleared when it grows past [`MEASURED_MAX`] entries.
     static MEASURED: RefCell<HashMap<(String, String), (u32, u32)>> = RefCell::new(HashMap::new());
+    /// JS strings of the texts, fonts and colours already passed to the context, by their Rust
+    /// text: the same few hundred come back on every frame, and making a JS string from UTF-8
+    /// costs more than the call that uses it. Cleared when it grows past [`MEASURED_MAX`].
+    static JS_STRINGS: RefCell<HashMap<String, JsValue>> = RefCell::new(HashMap::new());
+}
+
+/// Calls `f` with `text` as a JS string, made once and then reused ([`JS_STRINGS`]).
+fn with_js_string<R>(text: &str, f: impl FnOnce(&JsValue) -> R) -> R {
+    JS_STRINGS.with(|m| {
+        let mut m = m.borrow_mut();
+        if let Some(v) = m.get(text) {
+            return f(v);
+        }
+        if m.len() >= MEASURED_MAX {
+            m.clear();
+        }
+        let v = JsValue::from_str(text);
+        let r = f(&v);
+        m.insert(text.to_owned(), v);
+        r
+    })
 }
 /// Most text sizes [`MEASURED`] keeps.
 const MEASURED_MAX: usize = 4096;
@@ -125,12 +165,19 @@ impl Canvas {
         })
     }
 
+    /// The context, for the JS-string entry points.
+    fn js(&self) -> &Context2d {
+        self.context.unchecked_ref()
+    }
+
     /// Sets the stroke colour and width unless they are already set.
     fn line_style<S: BackendStyle>(&self, style: &S) {
         let want = (rgba(style.color()), style.stroke_width());
         let mut st = self.state.borrow_mut();
         if st.stroke != Some(want) {
-            self.context.set_stroke_style_str(&css_color(style.color()));
+            with_js_string(&css_color(style.color()), |c| {
+                self.js().set_stroke_style_js(c)
+            });
             self.context.set_line_width(f64::from(want.1));
             st.stroke = Some(want);
         }
@@ -141,7 +188,7 @@ impl Canvas {
         let want = rgba(color);
         let mut st = self.state.borrow_mut();
         if st.fill != Some(want) {
-            self.context.set_fill_style_str(&css_color(color));
+            with_js_string(&css_color(color), |c| self.js().set_fill_style_js(c));
             st.fill = Some(want);
         }
     }
@@ -151,7 +198,7 @@ impl Canvas {
         let want = css_font(style);
         let mut st = self.state.borrow_mut();
         if st.font.as_ref() != Some(&want) {
-            self.context.set_font(&want);
+            with_js_string(&want, |f| self.js().set_font_js(f));
             st.font = Some(want);
         }
     }
@@ -372,17 +419,12 @@ impl DrawingBackend for Canvas {
         }
         self.fill_style(color);
         self.font(style);
-        match self
-            .context
-            .fill_text(text, f64::from(pos.0), f64::from(pos.1))
-        {
-            Ok(()) => Ok(()),
-            // Never seen; CanvasBackend reports the error in its own type.
-            Err(_) => {
-                self.forget();
-                self.inner.draw_text(text, style, pos)
-            }
-        }
+        // fillText throws only for a non-finite position, which integer pixels are not.
+        with_js_string(text, |t| {
+            self.js()
+                .fill_text_js(t, f64::from(pos.0), f64::from(pos.1))
+        });
+        Ok(())
     }
 
     fn estimate_text_size<S: BackendTextStyle>(
