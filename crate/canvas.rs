@@ -15,9 +15,9 @@
 //! translucent circles are then filled once, not twice). Text sizes are remembered across
 //! frames (the same tick labels come back on every edit), and so are the JS strings of texts,
 //! fonts and colours, passed to the context as they are instead of decoded from UTF-8 on every
-//! call. Bitmaps (the sensitivity map) are
-//! written with one `putImageData`. Everything else is delegated to `CanvasBackend`, after
-//! which the remembered state is forgotten (it may have changed it). Compiled only for wasm32.
+//! call. Bitmaps (the sensitivity map) are written with one `putImageData`. Everything else is
+//! delegated to `CanvasBackend`, after which the remembered state is forgotten (it may have
+//! changed it). Compiled only for wasm32.
 
 use plotters::prelude::DrawingBackend;
 use plotters_backend::text_anchor::{HPos, VPos};
