@@ -367,20 +367,39 @@ fn canvas(canvases: &JsValue, key: &str) -> Option<HtmlCanvasElement> {
         .and_then(|c| c.dyn_into::<HtmlCanvasElement>().ok())
 }
 
-/// Labels for the compared shapers: the family's title, numbered when repeated.
+/// Labels for the compared shapers: the family's title, with the count written in for the
+/// families named by one (`ZV-D³`, `4-hump EI`), numbered when still repeated.
 fn labels(specs: &[ShaperSpec]) -> Vec<String> {
-    specs
+    let titles: Vec<String> = specs.iter().map(title).collect();
+    titles
         .iter()
         .enumerate()
-        .map(|(i, spec)| {
-            let title = spec.info().map_or("shaper", |f| f.title);
-            let repeated = specs.iter().filter(|s| s.name() == spec.name()).count() > 1;
-            if repeated {
-                format!("{title} #{}", i + 1)
+        .map(|(i, t)| {
+            if titles.iter().filter(|u| *u == t).count() > 1 {
+                format!("{t} #{}", i + 1)
             } else {
-                title.to_string()
+                t.clone()
             }
         })
+        .collect()
+}
+
+/// A spec's family title, with the derivative or hump count written in where the family's
+/// title leaves it as n.
+fn title(spec: &ShaperSpec) -> String {
+    match spec {
+        ShaperSpec::Zvdn { derivatives } => format!("ZV-D{}", superscript(*derivatives)),
+        ShaperSpec::Eihump { humps, .. } => format!("{humps}-hump EI"),
+        _ => spec.info().map_or("shaper", |f| f.title).to_string(),
+    }
+}
+
+/// `n` in superscript digits (³, ¹²).
+fn superscript(n: u32) -> String {
+    const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    n.to_string()
+        .bytes()
+        .map(|b| DIGITS[usize::from(b - b'0')])
         .collect()
 }
 

@@ -302,3 +302,30 @@ fn analyses_kept_between_frames_follow_every_input_they_depend_on() {
         last_analysis = analysis;
     }
 }
+
+/// The compared shapers' labels (legends, table headers) name the count of the families titled
+/// by one: ZV-D³ and ZV-D¹² are told apart; identical labels are still numbered by position.
+#[wasm_bindgen_test]
+fn labels_write_in_the_derivative_and_hump_counts() {
+    let state = JSON::parse(
+        r#"{"modes":[{"frequencyHz":2,"damping":0.05}],
+            "shapers":[{"family":"zvdn","derivatives":3},{"family":"zvdn","derivatives":12},
+                       {"family":"eihump","humps":4},{"family":"eihump","humps":4}]}"#,
+    )
+    .unwrap();
+    let result = wasm::render_playground(state, JsValue::from(js_sys::Object::new())).unwrap();
+    let results: js_sys::Array = Reflect::get(&result, &"results".into())
+        .unwrap()
+        .dyn_into()
+        .unwrap();
+    let labels: Vec<String> = results
+        .iter()
+        .map(|r| {
+            Reflect::get(&r, &"label".into())
+                .unwrap()
+                .as_string()
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(labels, ["ZV-D³", "ZV-D¹²", "4-hump EI #3", "4-hump EI #4"]);
+}
