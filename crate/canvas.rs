@@ -15,7 +15,9 @@
 //! translucent circles are then filled once, not twice). Text sizes are remembered across
 //! frames (the same tick labels come back on every edit), and so are the JS strings of texts,
 //! fonts and colours, passed to the context as they are instead of decoded from UTF-8 on every
-//! call. Bitmaps (the sensitivity map) are written with one `putImageData`. Everything else is
+//! call. A polyline is drawn through the vertices that keep every point within a quarter pixel
+//! ([`crate::chart::simplify_polyline`]): a third of the `lineTo` calls of a 4-shaper frame.
+//! Bitmaps (the sensitivity map) are written with one `putImageData`. Everything else is
 //! delegated to `CanvasBackend`, after which the remembered state is forgotten (it may have
 //! changed it). Compiled only for wasm32.
 
@@ -56,6 +58,8 @@ struct ContextState {
     align: Option<(&'static str, &'static str)>,
     /// What the current path holds that is not yet stroked or filled (in the style above).
     open: Open,
+    /// Scratch space for a polyline's vertices.
+    path: Vec<(i32, i32)>,
 }
 
 /// The shapes collected in the current path, drawn by one `stroke` or `fill` when something
@@ -97,6 +101,10 @@ fn with_js_string<R>(text: &str, f: impl FnOnce(&JsValue) -> R) -> R {
         r
     })
 }
+/// How far (in canvas pixels) a polyline's dropped points may lie from the segments drawn
+/// instead: a quarter of the thinnest line.
+const PATH_TOLERANCE: f64 = 0.25;
+
 /// Most text sizes [`MEASURED`] keeps.
 const MEASURED_MAX: usize = 4096;
 
@@ -326,16 +334,19 @@ impl DrawingBackend for Canvas {
             return Ok(());
         }
         self.flush();
-        let mut path = path.into_iter();
+        // Only the vertices the drawing needs (within PATH_TOLERANCE px of every point).
+        let mut points = std::mem::take(&mut self.state.borrow_mut().path);
+        crate::chart::simplify_polyline(path, PATH_TOLERANCE, &mut points);
         self.context.begin_path();
-        if let Some(start) = path.next() {
+        if let Some((start, rest)) = points.split_first() {
             self.line_style(style);
             self.context.move_to(f64::from(start.0), f64::from(start.1));
-            for next in path {
+            for next in rest {
                 self.context.line_to(f64::from(next.0), f64::from(next.1));
             }
         }
         self.context.stroke();
+        self.state.borrow_mut().path = points;
         Ok(())
     }
 
