@@ -225,6 +225,14 @@ fn phasor_modulus_is_v_and_its_frequency_derivatives_match_differences() {
     }
 }
 
+/// Asserts `a[k] ≈ b[k]` within `tol` for every k (and equal lengths).
+fn all_close(a: &[f64], b: &[f64], tol: f64, what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: lengths");
+    for (x, y) in a.iter().zip(b) {
+        close(*x, *y, tol, what);
+    }
+}
+
 /// A convolved shaper is analysed through its factors (V of a convolution is the product of the
 /// factors' V, the transform of a convolution being the product of the transforms): every
 /// analysis of the factored shaper must match the same impulses analysed directly. Cases: three
@@ -291,9 +299,7 @@ fn convolved_shapers_analysed_by_factors_match_their_impulses() {
                 damping_sensitivity(&factored, &options).unwrap(),
                 damping_sensitivity(&direct, &options).unwrap(),
             );
-            for (x, y) in a.vibration.iter().zip(&b.vibration) {
-                close(*x, *y, 1e-13, "V(ζ)");
-            }
+            all_close(&a.vibration, &b.vibration, 1e-13, "V(ζ)");
         }
         let options = SensitivityOptions {
             from_hz: 0.0,
@@ -305,9 +311,7 @@ fn convolved_shapers_analysed_by_factors_match_their_impulses() {
             sensitivity(&factored, &options).unwrap(),
             sensitivity(&direct, &options).unwrap(),
         );
-        for (x, y) in a.vibration.iter().zip(&b.vibration) {
-            close(*x, *y, 1e-12, "V(f)");
-        }
+        all_close(&a.vibration, &b.vibration, 1e-12, "V(f)");
         let options = SensitivityMapOptions {
             from_hz: 0.1,
             to_hz: 20.0,
@@ -320,9 +324,7 @@ fn convolved_shapers_analysed_by_factors_match_their_impulses() {
             sensitivity_map(&factored, &options).unwrap(),
             sensitivity_map(&direct, &options).unwrap(),
         );
-        for (x, y) in a.vibration.iter().zip(&b.vibration) {
-            close(*x, *y, 1e-12, "map");
-        }
+        all_close(&a.vibration, &b.vibration, 1e-12, "map");
         let options = SpectrumOptions {
             from_hz: 0.0,
             to_hz: 30.0,
@@ -333,8 +335,6 @@ fn convolved_shapers_analysed_by_factors_match_their_impulses() {
             impulse_spectrum(&factored, &options).unwrap(),
             impulse_spectrum(&direct, &options).unwrap(),
         );
-        for (x, y) in a.magnitude.iter().zip(&b.magnitude) {
-            close(*x, *y, 1e-12, "|S(f)|");
-        }
+        all_close(&a.magnitude, &b.magnitude, 1e-12, "|S(f)|");
     }
 }

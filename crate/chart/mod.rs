@@ -471,6 +471,7 @@ mod tests {
     #[wasm_bindgen_test(unsupported = test)]
     fn simplified_polylines_stay_within_the_tolerance() {
         let mut seed = 12345_u64;
+        // A linear congruential generator (Knuth's MMIX constants): repeatable noise.
         let mut noise = move || {
             seed = seed
                 .wrapping_mul(6364136223846793005)
