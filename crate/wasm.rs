@@ -384,13 +384,20 @@ fn labels(specs: &[ShaperSpec]) -> Vec<String> {
         .collect()
 }
 
-/// A spec's family title, with the derivative or hump count written in where the family's
-/// title leaves it as n.
+/// A spec's family title (from [`FAMILIES`](crate::design::FAMILIES)), with the derivative or
+/// hump count written in where the title leaves it as n (`ZV-Dⁿ`, `n-hump EI`).
 fn title(spec: &ShaperSpec) -> String {
+    let title = spec.info().map_or("shaper", |f| f.title);
     match spec {
-        ShaperSpec::Zvdn { derivatives } => format!("ZV-D{}", superscript(*derivatives)),
-        ShaperSpec::Eihump { humps, .. } => format!("{humps}-hump EI"),
-        _ => spec.info().map_or("shaper", |f| f.title).to_string(),
+        ShaperSpec::Zvdn { derivatives } => match title.strip_suffix('ⁿ') {
+            Some(stem) => format!("{stem}{}", superscript(*derivatives)),
+            None => title.to_string(),
+        },
+        ShaperSpec::Eihump { humps, .. } => match title.strip_prefix("n-") {
+            Some(rest) => format!("{humps}-{rest}"),
+            None => title.to_string(),
+        },
+        _ => title.to_string(),
     }
 }
 
