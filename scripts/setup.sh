@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what building and testing need, skipping whatever is already there:
-#   the wasm32 target, the wasm-bindgen CLI at exactly the version in Cargo.lock, wasm-pack,
+#   the wasm32 target, the wasm-bindgen CLI at exactly the version in Cargo.lock, the pinned
+#   nightly toolchain with rust-src (scripts/nightly.sh; for the shipped wasm), wasm-pack,
 #   the npm packages, and (with --browser) Debian's chromium + chromium-driver.
 # Usage: bash scripts/setup.sh [--browser]
 set -euo pipefail
@@ -28,6 +29,18 @@ if [ "$have" != "$want" ]; then
   say "installing wasm-bindgen-cli $want (have: ${have:-none}); takes a few minutes"
   # No --locked: the crates.io mirror lacks a crate its lock file pins.
   cargo install wasm-bindgen-cli --version "$want" --force
+fi
+
+# The shipped wasm is built by a pinned nightly that recompiles the standard library for size
+# (scripts/build.sh; README, *Shipped size*). If it cannot be installed, the build falls back to
+# the stable toolchain (same code, ~24 KB gzip larger), so a missing nightly never fails a run.
+nightly=$(bash scripts/nightly.sh)
+if ! rustup run "$nightly" rustc --print sysroot >/dev/null 2>&1 \
+  || [ ! -d "$(rustup run "$nightly" rustc --print sysroot)/lib/rustlib/src/rust/library" ] \
+  || ! rustup target list --installed --toolchain "$nightly" 2>/dev/null | grep -qx wasm32-unknown-unknown; then
+  say "installing $nightly with rust-src (std built for size for the shipped wasm)"
+  rustup toolchain install "$nightly" --profile minimal --component rust-src --target wasm32-unknown-unknown \
+    || say "could not install $nightly: the page will be built with stable Rust (larger wasm)" >&2
 fi
 
 if ! command -v wasm-pack >/dev/null 2>&1; then
