@@ -614,71 +614,73 @@ fn fir_chunk_generic(delays: &[usize], weights: &[f64], scratch: &[f64], m: usiz
     }
 }
 
-/// A command as written in a spec (`{ kind, … }`). Times in seconds, distances in the
-/// machine's length unit (metres, radians, …), velocities per second.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "camelCase")]
-pub enum CommandSpec {
-    /// A step of `distance` at `start`.
-    Step {
-        /// Height of the step (default 1).
-        #[serde(default = "one")]
-        distance: f64,
-        /// Time of the step in seconds (default 0).
-        #[serde(default)]
-        start: f64,
-    },
-    /// A ramp of `slope` per second from `start` on (never ends).
-    Ramp {
-        /// Slope, units per second (default 1).
-        #[serde(default = "one")]
-        slope: f64,
-        /// Start time in seconds (default 0).
-        #[serde(default)]
-        start: f64,
-    },
-    /// Trapezoidal velocity profile; triangular when the move is too short to reach
-    /// `maxVelocity` (Peláez & Singhose 2002 §1).
-    #[serde(rename_all = "camelCase")]
-    Trapezoid {
-        /// Distance to travel (may be negative).
-        distance: f64,
-        /// Velocity limit (> 0).
-        max_velocity: f64,
-        /// Acceleration limit (> 0).
-        max_acceleration: f64,
-        /// Start time in seconds (default 0).
-        #[serde(default)]
-        start: f64,
-    },
-    /// Jerk-limited (seven-segment) S-curve.
-    #[serde(rename_all = "camelCase")]
-    SCurve {
-        /// Distance to travel (may be negative).
-        distance: f64,
-        /// Velocity limit (> 0).
-        max_velocity: f64,
-        /// Acceleration limit (> 0).
-        max_acceleration: f64,
-        /// Jerk limit (> 0).
-        max_jerk: f64,
-        /// Start time in seconds (default 0).
-        #[serde(default)]
-        start: f64,
-    },
-    /// An arbitrary sampled signal (e.g. a joystick), `values[k]` at t = k·`samplePeriod`.
-    #[serde(rename_all = "camelCase")]
-    Sampled {
-        /// Sample period in seconds.
-        sample_period: f64,
-        /// The samples.
-        values: Vec<f64>,
-        /// `"linear"` (default) or `"hold"`.
-        #[serde(default)]
-        interpolation: Interpolation,
-    },
-    /// A pulse-convolution profile (Veciana & Cardona 2011), see [`ProfileSpec`].
-    Profile(ProfileSpec),
+crate::tagged::tagged_enum! {
+    tag = "kind", rename_all = "camelCase", mirror = command_spec_serde;
+    /// A command as written in a spec (`{ kind, … }`). Times in seconds, distances in the
+    /// machine's length unit (metres, radians, …), velocities per second.
+    #[derive(Debug, Clone, PartialEq)]
+    pub enum CommandSpec {
+        /// A step of `distance` at `start`.
+        Step {
+            /// Height of the step (default 1).
+            #[serde(default = "one")]
+            distance: f64,
+            /// Time of the step in seconds (default 0).
+            #[serde(default)]
+            start: f64,
+        },
+        /// A ramp of `slope` per second from `start` on (never ends).
+        Ramp {
+            /// Slope, units per second (default 1).
+            #[serde(default = "one")]
+            slope: f64,
+            /// Start time in seconds (default 0).
+            #[serde(default)]
+            start: f64,
+        },
+        /// Trapezoidal velocity profile; triangular when the move is too short to reach
+        /// `maxVelocity` (Peláez & Singhose 2002 §1).
+        #[serde(rename_all = "camelCase")]
+        Trapezoid {
+            /// Distance to travel (may be negative).
+            distance: f64,
+            /// Velocity limit (> 0).
+            max_velocity: f64,
+            /// Acceleration limit (> 0).
+            max_acceleration: f64,
+            /// Start time in seconds (default 0).
+            #[serde(default)]
+            start: f64,
+        },
+        /// Jerk-limited (seven-segment) S-curve.
+        #[serde(rename_all = "camelCase")]
+        SCurve {
+            /// Distance to travel (may be negative).
+            distance: f64,
+            /// Velocity limit (> 0).
+            max_velocity: f64,
+            /// Acceleration limit (> 0).
+            max_acceleration: f64,
+            /// Jerk limit (> 0).
+            max_jerk: f64,
+            /// Start time in seconds (default 0).
+            #[serde(default)]
+            start: f64,
+        },
+        /// An arbitrary sampled signal (e.g. a joystick), `values[k]` at t = k·`samplePeriod`.
+        #[serde(rename_all = "camelCase")]
+        Sampled {
+            /// Sample period in seconds.
+            sample_period: f64,
+            /// The samples.
+            values: Vec<f64>,
+            /// `"linear"` (default) or `"hold"`.
+            #[serde(default)]
+            interpolation: Interpolation,
+        },
+        /// A pulse-convolution profile (Veciana & Cardona 2011), see [`ProfileSpec`].
+        Profile(ProfileSpec),
+    }
 }
 
 fn one() -> f64 {

@@ -121,8 +121,17 @@ fn key_segment(key: &Option<String>) -> Segment {
 
 /// Elements of a JS array (by index, as js_sys's `ArrayIter`) or of any JS iterator.
 enum SeqAccess {
-    Array { array: Array, next: u32, len: u32 },
+    Array {
+        array: Array,
+        next: u32,
+        len: u32,
+    },
     Iter(js_sys::IntoIter, usize),
+    /// One value `left` more times, read at the current path ([`crate::tagged::SAME`]).
+    Same {
+        value: JsValue,
+        left: usize,
+    },
 }
 
 impl SeqAccess {
@@ -149,6 +158,13 @@ impl<'de> de::SeqAccess<'de> for SeqAccess {
                 *next += 1;
                 (value, *next as usize - 1)
             }
+            SeqAccess::Same { value, left } => {
+                if *left == 0 {
+                    return Ok(None);
+                }
+                *left -= 1;
+                return seed.deserialize(De::new(value.clone(), true)).map(Some);
+            }
             SeqAccess::Iter(iter, next) => match iter.next() {
                 None => return Ok(None),
                 Some(Err(e)) => return Err(note(Error::from(e))),
@@ -167,6 +183,7 @@ impl<'de> de::SeqAccess<'de> for SeqAccess {
         match self {
             SeqAccess::Array { next, len, .. } => Some((*len - *next) as usize),
             SeqAccess::Iter(..) => None,
+            SeqAccess::Same { left, .. } => Some(*left),
         }
     }
 }
@@ -280,10 +297,13 @@ impl<'de> de::MapAccess<'de> for MapAccess {
     }
 }
 
-/// An enum as serde-json writes it: `"Variant"` or `{ Variant: payload }`.
+/// An enum as serde-json writes it: `"Variant"` or `{ Variant: payload }`; or, with
+/// `tag_field`, internally tagged: `{ [tag_field]: "variant", …fields }` ([`crate::tagged`]),
+/// the payload being the object itself.
 struct EnumAccess {
     tag: JsValue,
     payload: JsValue,
+    tag_field: Option<&'static str>,
 }
 
 impl<'de> de::EnumAccess<'de> for EnumAccess {
@@ -291,6 +311,20 @@ impl<'de> de::EnumAccess<'de> for EnumAccess {
     type Variant = VariantAccess;
 
     fn variant_seed<V: DeserializeSeed<'de>>(self, seed: V) -> Result<(V::Value, VariantAccess)> {
+        if let Some(field) = self.tag_field {
+            // A bad tag is reported at the tag's field (`shapers[0].family`).
+            let v = seed
+                .deserialize(De::new(self.tag, false))
+                .map_err(|e| fail_at(Segment::Key(field.to_string()), e))?;
+            return Ok((
+                v,
+                VariantAccess {
+                    payload: self.payload,
+                    variant: None,
+                    tagged: true,
+                },
+            ));
+        }
         let variant = self.tag.as_string();
         let v = seed.deserialize(De::new(self.tag, false)).map_err(note)?;
         Ok((
@@ -298,20 +332,39 @@ impl<'de> de::EnumAccess<'de> for EnumAccess {
             VariantAccess {
                 payload: self.payload,
                 variant,
+                tagged: false,
             },
         ))
     }
 }
 
+/// An internally tagged variant (`tagged`) reads its fields from the tagged object itself, at
+/// the object's path; an externally tagged one from the payload, under the variant's name.
 struct VariantAccess {
     payload: JsValue,
     variant: Option<String>,
+    tagged: bool,
+}
+
+impl VariantAccess {
+    fn read<T>(self, f: impl FnOnce(De) -> Result<T>) -> Result<T> {
+        let payload = De::new(self.payload, true);
+        if self.tagged {
+            f(payload)
+        } else {
+            within(key_segment(&self.variant), || f(payload))
+        }
+    }
 }
 
 impl<'de> de::VariantAccess<'de> for VariantAccess {
     type Error = Error;
 
     fn unit_variant(self) -> Result<()> {
+        if self.tagged {
+            // The object's other fields are ignored, as serde's internally tagged enums do.
+            return Ok(());
+        }
         let payload = self.payload;
         within(key_segment(&self.variant), || {
             de::Deserialize::deserialize(De::new(payload, false))
@@ -319,17 +372,11 @@ impl<'de> de::VariantAccess<'de> for VariantAccess {
     }
 
     fn newtype_variant_seed<T: DeserializeSeed<'de>>(self, seed: T) -> Result<T::Value> {
-        let payload = self.payload;
-        within(key_segment(&self.variant), || {
-            seed.deserialize(De::new(payload, true))
-        })
+        self.read(|payload| seed.deserialize(payload))
     }
 
     fn tuple_variant<V: Visitor<'de>>(self, len: usize, visitor: V) -> Result<V::Value> {
-        let payload = self.payload;
-        within(key_segment(&self.variant), || {
-            de::Deserializer::deserialize_tuple(De::new(payload, true), len, visitor)
-        })
+        self.read(|payload| de::Deserializer::deserialize_tuple(payload, len, visitor))
     }
 
     fn struct_variant<V: Visitor<'de>>(
@@ -337,16 +384,13 @@ impl<'de> de::VariantAccess<'de> for VariantAccess {
         fields: &'static [&'static str],
         visitor: V,
     ) -> Result<V::Value> {
-        let payload = self.payload;
-        within(key_segment(&self.variant), || {
-            de::Deserializer::deserialize_struct(De::new(payload, true), "", fields, visitor)
-        })
+        self.read(|payload| de::Deserializer::deserialize_struct(payload, "", fields, visitor))
     }
 }
 
 /// A JS value as a serde `Deserializer`. `track`: whether a failure records the path (map keys
 /// and enum tags are read untracked, as path_to_error reads them).
-struct De {
+pub(crate) struct De {
     value: JsValue,
     track: bool,
 }
@@ -526,11 +570,34 @@ impl De {
         }
     }
 
+    /// `{ [field]: "variant", …fields }` ([`crate::tagged`]): the tag is read first, the
+    /// variant's fields from the same object.
+    fn tagged_enum<'de, V: Visitor<'de>>(
+        self,
+        field: &'static str,
+        visitor: V,
+    ) -> Result<V::Value> {
+        if !self.value.is_object() {
+            return self.invalid_type(visitor);
+        }
+        let key = JsValue::from_str(field);
+        let tag = js_sys::Reflect::get(&self.value, &key)?;
+        if tag.is_undefined() && !js_sys::Reflect::has(&self.value, &key)? {
+            return Err(de::Error::missing_field(field));
+        }
+        visitor.visit_enum(EnumAccess {
+            tag,
+            payload: self.value,
+            tag_field: Some(field),
+        })
+    }
+
     fn enum_<'de, V: Visitor<'de>>(self, visitor: V) -> Result<V::Value> {
         let access = if self.value.is_string() {
             EnumAccess {
                 tag: self.value,
                 payload: JsValue::UNDEFINED,
+                tag_field: None,
             }
         } else if self.value.is_object() {
             let entries = Object::entries(self.value.unchecked_ref());
@@ -538,7 +605,11 @@ impl De {
                 return Err(de::Error::invalid_length(entries.length() as _, &"1"));
             }
             let (tag, payload) = convert_pair(entries.get(0));
-            EnumAccess { tag, payload }
+            EnumAccess {
+                tag,
+                payload,
+                tag_field: None,
+            }
         } else {
             return self.invalid_type(visitor);
         };
@@ -626,10 +697,21 @@ impl<'de> de::Deserializer<'de> for De {
 
     fn deserialize_tuple_struct<V: Visitor<'de>>(
         self,
-        _name: &'static str,
-        _len: usize,
+        name: &'static str,
+        len: usize,
         visitor: V,
     ) -> Result<V::Value> {
+        if name == crate::tagged::SAME {
+            let r = if self.value.is_object() {
+                visitor.visit_seq(SeqAccess::Same {
+                    value: self.value.clone(),
+                    left: len,
+                })
+            } else {
+                self.invalid_type(visitor)
+            };
+            return self.done(r);
+        }
         self.deserialize_seq(visitor)
     }
 
@@ -653,12 +735,15 @@ impl<'de> de::Deserializer<'de> for De {
 
     fn deserialize_enum<V: Visitor<'de>>(
         self,
-        _name: &'static str,
-        _variants: &'static [&'static str],
+        name: &'static str,
+        variants: &'static [&'static str],
         visitor: V,
     ) -> Result<V::Value> {
         let track = self.track;
-        let r = self.enum_(visitor);
+        let r = match variants.first() {
+            Some(field) if name == crate::tagged::TAGGED => self.tagged_enum(field, visitor),
+            _ => self.enum_(visitor),
+        };
         if track {
             r.map_err(note)
         } else {

@@ -53,6 +53,7 @@ pub mod smoothing;
 pub mod solve;
 mod sort;
 pub mod spectrum;
+mod tagged;
 pub mod vibration;
 
 #[cfg(target_arch = "wasm32")]

@@ -28,63 +28,65 @@
 
 use crate::command::{Cursor, Knot, Piecewise, MAX_DEGREE, ORDER};
 use crate::error::{finite, positive, Error, Result};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 /// Most pulses in one profile (the position is then a polynomial of degree [`MAX_DEGREE`]).
 pub const MAX_PULSES: usize = MAX_DEGREE;
 
-/// A pulse-convolution profile as written in a command spec (`{ kind: "profile", shape, … }`):
-/// a rest-to-rest move of `distance` lasting `duration` seconds.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "shape", rename_all = "camelCase")]
-pub enum ProfileSpec {
-    /// One pulse of 1/f₀ and a final pulse: a trapezoidal velocity (§2.1, Fig. 3).
-    #[serde(rename_all = "camelCase")]
-    Pulse {
-        /// Mode frequency f₀ in Hz.
-        frequency_hz: f64,
-        /// Distance of the move.
-        distance: f64,
-        /// Total duration in seconds (≥ 1/f₀).
-        duration: f64,
-    },
-    /// Two pulses of 1/f₀ (a triangle) and a final pulse (§2.3, eq. 23 with p = 1, Fig. 7).
-    #[serde(rename_all = "camelCase")]
-    Triangle {
-        /// Mode frequency f₀ in Hz.
-        frequency_hz: f64,
-        /// Distance of the move.
-        distance: f64,
-        /// Total duration in seconds (≥ 2/f₀).
-        duration: f64,
-    },
-    /// Pulses of 1/(f₀ + Δf) and 1/(f₀ − Δf) and a final pulse (§2.3, Fig. 8).
-    #[serde(rename_all = "camelCase")]
-    RobustTrapezium {
-        /// Mode frequency f₀ in Hz.
-        frequency_hz: f64,
-        /// Half-width Δf of the suppressed band in Hz (0 ≤ Δf < f₀).
-        delta_hz: f64,
-        /// Distance of the move.
-        distance: f64,
-        /// Total duration in seconds (≥ 1/(f₀+Δf) + 1/(f₀−Δf)).
-        duration: f64,
-    },
-    /// One pulse of 1/fᵢ per listed mode, one of 1/f_cmd if `commonHz` is given, and a final
-    /// pulse (§2.4, eq. 28, Fig. 10).
-    #[serde(rename_all = "camelCase")]
-    MultiMode {
-        /// Frequencies in Hz of the modes given their own pulse.
-        modes_hz: Vec<f64>,
-        /// A common frequency f_cmd in Hz (fᵢ ≈ integer × f_cmd) whose one pulse replaces the
-        /// modes it covers (leave those out of `modesHz`).
-        #[serde(default)]
-        common_hz: Option<f64>,
-        /// Distance of the move.
-        distance: f64,
-        /// Total duration in seconds (≥ the sum of the pulses).
-        duration: f64,
-    },
+crate::tagged::tagged_enum! {
+    tag = "shape", rename_all = "camelCase", mirror = profile_spec_serde;
+    /// A pulse-convolution profile as written in a command spec (`{ kind: "profile", shape, … }`):
+    /// a rest-to-rest move of `distance` lasting `duration` seconds.
+    #[derive(Debug, Clone, PartialEq)]
+    pub enum ProfileSpec {
+        /// One pulse of 1/f₀ and a final pulse: a trapezoidal velocity (§2.1, Fig. 3).
+        #[serde(rename_all = "camelCase")]
+        Pulse {
+            /// Mode frequency f₀ in Hz.
+            frequency_hz: f64,
+            /// Distance of the move.
+            distance: f64,
+            /// Total duration in seconds (≥ 1/f₀).
+            duration: f64,
+        },
+        /// Two pulses of 1/f₀ (a triangle) and a final pulse (§2.3, eq. 23 with p = 1, Fig. 7).
+        #[serde(rename_all = "camelCase")]
+        Triangle {
+            /// Mode frequency f₀ in Hz.
+            frequency_hz: f64,
+            /// Distance of the move.
+            distance: f64,
+            /// Total duration in seconds (≥ 2/f₀).
+            duration: f64,
+        },
+        /// Pulses of 1/(f₀ + Δf) and 1/(f₀ − Δf) and a final pulse (§2.3, Fig. 8).
+        #[serde(rename_all = "camelCase")]
+        RobustTrapezium {
+            /// Mode frequency f₀ in Hz.
+            frequency_hz: f64,
+            /// Half-width Δf of the suppressed band in Hz (0 ≤ Δf < f₀).
+            delta_hz: f64,
+            /// Distance of the move.
+            distance: f64,
+            /// Total duration in seconds (≥ 1/(f₀+Δf) + 1/(f₀−Δf)).
+            duration: f64,
+        },
+        /// One pulse of 1/fᵢ per listed mode, one of 1/f_cmd if `commonHz` is given, and a final
+        /// pulse (§2.4, eq. 28, Fig. 10).
+        #[serde(rename_all = "camelCase")]
+        MultiMode {
+            /// Frequencies in Hz of the modes given their own pulse.
+            modes_hz: Vec<f64>,
+            /// A common frequency f_cmd in Hz (fᵢ ≈ integer × f_cmd) whose one pulse replaces the
+            /// modes it covers (leave those out of `modesHz`).
+            #[serde(default)]
+            common_hz: Option<f64>,
+            /// Distance of the move.
+            distance: f64,
+            /// Total duration in seconds (≥ the sum of the pulses).
+            duration: f64,
+        },
+    }
 }
 
 /// Durations of the pulses a spec asks for, before the final pulse; validated.

@@ -8,7 +8,9 @@
 
 use crate::design::direct::DirectSpec;
 use crate::design::extra_insensitive::DEFAULT_VTOL;
-use crate::design::{design_for, ShaperSpec, FAMILIES};
+#[cfg(doc)]
+use crate::design::FAMILIES;
+use crate::design::{design_for, ShaperSpec};
 use crate::error::{count, Error, Result};
 use crate::mode::Mode;
 use crate::vibration::{damping_insensitivity, insensitivity, tolerable_vibration};

@@ -131,7 +131,7 @@ pub fn simulate(
 
 /// The shaper of a simulation spec: a family and its parameters, designed for `modes` (or, if
 /// `modes` is left out, for the plant's own modes).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ShaperRequest {
     /// The modes the shaper is designed for (the model); default: the plant's.
     #[serde(default)]
@@ -139,6 +139,33 @@ pub struct ShaperRequest {
     /// The family and its parameters (as `design` takes them).
     #[serde(flatten)]
     pub shaper: ShaperSpec,
+}
+
+/// `{ modes?, family, …parameters }`, read as [`crate::DesignRequest`] is.
+impl<'de> Deserialize<'de> for ShaperRequest {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        struct Modes {
+            #[serde(default)]
+            modes: Option<Vec<ModeSpec>>,
+        }
+        #[derive(Deserialize)]
+        struct ShaperRequest {
+            #[serde(default)]
+            modes: Option<Vec<ModeSpec>>,
+            #[serde(flatten)]
+            shaper: ShaperSpec,
+        }
+        let (modes, shaper) = if !crate::tagged::ANY_DESERIALIZER || crate::tagged::is_js::<D>() {
+            let (Modes { modes }, shaper) =
+                crate::tagged::deserialize_flat(d, "struct ShaperRequest")?;
+            (modes, shaper)
+        } else {
+            let ShaperRequest { modes, shaper } = ShaperRequest::deserialize(d)?;
+            (modes, shaper)
+        };
+        Ok(Self { modes, shaper })
+    }
 }
 
 /// Everything a simulation needs, as written in JSON.

@@ -287,22 +287,32 @@ impl Default for PlaygroundView {
     }
 }
 
-/// The playground's simulated plant: `modal` (the modes × mismatch, equal participation) or
-/// `pendulum` (a nonlinear crane pendulum whose linearised mode is the first mode × mismatch).
-#[derive(Deserialize, Default, Clone, Copy)]
-#[serde(tag = "kind", rename_all = "camelCase")]
-enum ViewPlant {
-    #[default]
-    Modal,
-    #[serde(rename_all = "camelCase")]
-    Pendulum {
-        /// Gravity, m/s² (default 9.81).
-        #[serde(default = "default_gravity")]
-        gravity: f64,
-        /// Swing angle at t = 0, rad (default 0).
-        #[serde(default)]
-        initial_angle: f64,
-    },
+crate::tagged::tagged_enum! {
+    tag = "kind", rename_all = "camelCase", mirror = view_plant_serde;
+    /// The playground's simulated plant: `modal` (the modes × mismatch, equal participation) or
+    /// `pendulum` (a nonlinear crane pendulum whose linearised mode is the first mode × mismatch).
+    #[derive(Clone, Copy)]
+    enum ViewPlant {
+        Modal,
+        #[serde(rename_all = "camelCase")]
+        Pendulum {
+            /// Gravity, m/s² (default 9.81).
+            #[serde(default = "default_gravity")]
+            gravity: f64,
+            /// Swing angle at t = 0, rad (default 0).
+            #[serde(default)]
+            initial_angle: f64,
+        },
+    }
+}
+
+// Not derived: the variants' attributes (a `#[default]` too) are copied to the serde copies
+// of the enum, which derive no `Default`.
+#[allow(clippy::derivable_impls)]
+impl Default for ViewPlant {
+    fn default() -> Self {
+        ViewPlant::Modal
+    }
 }
 
 fn default_gravity() -> f64 {

@@ -20,7 +20,7 @@ dir=
 if [ "${STABLE:-0}" != 1 ] && sysroot=$(rustup run "$nightly" rustc --print sysroot 2>/dev/null) \
   && [ -d "$sysroot/lib/rustlib/src/rust/library" ]; then
   # Its own target directory: other RUSTFLAGS and std would rebuild the stable builds' cache.
-  if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build --release --lib --target "$target" \
+  if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build --release --lib --target "$target" --no-default-features \
     --target-dir target/shipped -Z build-std=std,panic_abort; then
     dir=target/shipped
     how="$nightly, std built for size"
@@ -30,7 +30,7 @@ if [ "${STABLE:-0}" != 1 ] && sysroot=$(rustup run "$nightly" rustc --print sysr
 fi
 if [ -z "$dir" ]; then
   dir=target
-  cargo build --release --lib --target "$target"
+  cargo build --release --lib --target "$target" --no-default-features
   how="stable Rust, prebuilt std: larger"
 fi
 rm -rf pkg

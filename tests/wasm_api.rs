@@ -114,6 +114,80 @@ fn errors_are_thrown_with_the_field_and_the_module_keeps_working() {
     assert!(wasm::design(js(r#"{"family":"zv","modes":[{"frequencyHz":3}]}"#)).is_ok());
 }
 
+/// Tagged specs (`family`, `kind`, `shape`) are read from the JS object itself, tag first
+/// (crate/tagged.rs), so a bad field inside one is named to the field, not only to the spec.
+#[wasm_bindgen_test]
+fn errors_inside_tagged_specs_name_the_field() {
+    let modes = r#""modes":[{"frequencyHz":1,"damping":0.05}]"#;
+    let design_cases = [
+        (format!(r#"{{"family":"ei","vtol":"x",{modes}}}"#), "vtol"),
+        (
+            format!(r#"{{"family":"zvdn","derivatives":1.5,{modes}}}"#),
+            "derivatives",
+        ),
+        (
+            format!(r#"{{"family":"custom","impulses":[{{"time":0,"amplitude":"x"}}],{modes}}}"#),
+            "impulses[0].amplitude",
+        ),
+        (
+            format!(r#"{{"family":"sampled","periodS":"a",{modes}}}"#),
+            "periodS",
+        ),
+        (format!(r#"{{"family":3,{modes}}}"#), "family"),
+        (format!(r#"{{"family":"nope",{modes}}}"#), "family"),
+    ];
+    for (spec, field) in &design_cases {
+        let (message, got) = error_message(wasm::design(js(spec)).unwrap_err());
+        assert_eq!(got.as_deref(), Some(*field), "{spec}: {message}");
+    }
+    // The tag missing, or the spec not an object: the spec itself is at fault.
+    let (message, got) = error_message(wasm::design(js(&format!("{{{modes}}}"))).unwrap_err());
+    assert_eq!(got, None, "{message}");
+    assert!(message.contains("missing field `family`"), "{message}");
+    let (message, _) = error_message(wasm::design(js(r#""zv""#)).unwrap_err());
+    assert!(message.contains("invalid type: string"), "{message}");
+
+    let plant = r#""plant":{"kind":"modal","modes":[{"frequencyHz":1,"damping":0.05}]}"#;
+    let simulate_cases = [
+        (
+            format!(r#"{{{plant},"command":{{"kind":"profile","shape":"nope"}}}}"#),
+            "command.shape",
+        ),
+        (
+            format!(
+                r#"{{{plant},"command":{{"kind":"trapezoid","distance":1,"maxVelocity":"a","maxAcceleration":1}}}}"#
+            ),
+            "command.maxVelocity",
+        ),
+        (
+            format!(
+                r#"{{{plant},"command":{{"kind":"step"}},"shaper":{{"family":"ei","vtol":"q"}}}}"#
+            ),
+            "shaper.vtol",
+        ),
+        (
+            r#"{"plant":{"kind":"nope"},"command":{"kind":"step"}}"#.to_string(),
+            "plant.kind",
+        ),
+        (
+            format!(r#"{{{plant},"command":{{"distance":1}}}}"#),
+            "command",
+        ),
+    ];
+    for (spec, field) in &simulate_cases {
+        let (message, got) = error_message(wasm::simulate(js(spec)).unwrap_err());
+        assert_eq!(got.as_deref(), Some(*field), "{spec}: {message}");
+    }
+    // The same spec reads as before once it is right.
+    let shaper = wasm::design(js(&format!(r#"{{"family":"ei","vtol":0.05,{modes}}}"#))).unwrap();
+    assert_eq!(
+        get(&shaper, "impulses")
+            .unchecked_into::<js_sys::Array>()
+            .length(),
+        3
+    );
+}
+
 #[wasm_bindgen_test]
 fn exports_and_klipper_figures() {
     let shaper = wasm::design(js(

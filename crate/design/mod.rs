@@ -25,102 +25,104 @@ use crate::mode::{Mode, ModeSpec};
 use crate::shaper::Shaper;
 use serde::{Deserialize, Serialize};
 
-/// A family of shapers and its parameters (the `family` field selects the variant).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "family", rename_all = "lowercase")]
-pub enum ShaperSpec {
-    /// Zero vibration: 2 impulses, ½ damped period (Singhose 2009 eqs. 14–15).
-    Zv,
-    /// Zero vibration and derivative: 3 impulses, 1 period (Singhose 2009 eq. 17).
-    Zvd,
-    /// Zero vibration and two derivatives: 4 impulses, 1½ periods (Singer & Seering 1988).
-    Zvdd,
-    /// Zero vibration and `derivatives` derivatives: n + 2 impulses, (n+1)/2 periods.
-    Zvdn {
-        /// Number of zero derivatives n (0 = ZV, 1 = ZVD, …), at most
-        /// [`zero_vibration::MAX_DERIVATIVES`].
-        derivatives: u32,
-    },
-    /// Impulses on the controller period with a prescribed ramp delay and the least control
-    /// error (Kamel, Lange & Hirzinger); parameters in [`sampled::SampledSpec`].
-    Sampled(sampled::SampledSpec),
-    /// Extra-insensitive: V = `vtol` with zero slope at the mode (a hump), zeros either side;
-    /// 3 impulses, about 1 period (Singhose 2009 §3.1, Fig. 7), solved exactly with damping.
-    Ei {
-        /// Height of the hump, fraction (default 0.05 = 5 %), 0.001 … 0.5.
-        #[serde(default = "default_vtol")]
-        vtol: f64,
-    },
-    /// Two-hump EI: humps of height `vtol` either side of the mode, V = 0 at the mode;
-    /// 4 impulses, about 1½ periods.
-    Ei2 {
-        /// Height of the humps, fraction (default 0.05).
-        #[serde(default = "default_vtol")]
-        vtol: f64,
-    },
-    /// Three-hump EI: the middle hump at the mode; 5 impulses, about 2 periods.
-    Ei3 {
-        /// Height of the humps, fraction (default 0.05).
-        #[serde(default = "default_vtol")]
-        vtol: f64,
-    },
-    /// n-hump EI: `humps` humps of height `vtol`, n + 2 impulses, about (n+1)/2 periods.
-    Eihump {
-        /// Number of humps n, 1 … [`extra_insensitive::MAX_HUMPS`] (1 = EI).
-        humps: u32,
-        /// Height of the humps, fraction (default 0.05).
-        #[serde(default = "default_vtol")]
-        vtol: f64,
-    },
-    /// Klipper's modified ZV: 3 impulses over 0.75 damped period, V = 0 at the mode and near
-    /// 5/3 of it (Klipper shaper_defs.py).
-    Mzv,
-    /// Unity-magnitude ZV: [1, −1, 1], V = 0 at the mode; T/3 long at ζ = 0
-    /// (Singhose 2009 §5).
-    Umzv,
-    /// Unity-magnitude ZVD: [1, −1, 1, −1, 1], V = 0 and dV/dω = 0 at the mode.
-    Umzvd,
-    /// Unity-magnitude EI: [1, −1, 1, −1, 1], a hump V = `vtol` at the mode.
-    Umei {
-        /// Height of the hump, fraction (default 0.05).
-        #[serde(default = "default_vtol")]
-        vtol: f64,
-    },
-    /// Time-optimal rest-to-rest move of one flexible mode plus rigid body: [1, −2, 2, −2, 1],
-    /// amplitudes sum to 0 — convolve with a step of height `maxAcceleration` (Singhose 2009
-    /// Fig. 13).
-    #[serde(rename_all = "camelCase")]
-    Bangbang {
-        /// Move distance (any length unit).
-        distance: f64,
-        /// Actuator acceleration limit (same length unit per s²).
-        max_acceleration: f64,
-    },
-    /// Fuel-efficient on/off move: [1, −1, 1, −1, −1, 1, −1, 1] with a coast (Singhose 2009
-    /// Fig. 14); amplitudes sum to 0, applied like `bangbang`.
-    #[serde(rename_all = "camelCase")]
-    Onoff {
-        /// Move distance (any length unit).
-        distance: f64,
-        /// Actuator acceleration limit (same length unit per s²).
-        max_acceleration: f64,
-        /// Time with the actuator off between accelerating and decelerating, s (> 0).
-        coast_time: f64,
-    },
-    /// Your own impulses `[{ time, amplitude }]`, validated; the modes are not used.
-    Custom {
-        /// The impulses, any order (merged when at the same time, shifted to start at 0).
-        impulses: Vec<crate::shaper::Impulse>,
-        /// Divide the amplitudes by their sum (default false).
-        #[serde(default)]
-        normalize: bool,
-    },
-    /// Specified insensitivity: the shortest shaper with V ≤ Vtol over a band of frequencies
-    /// (and dampings), sampled or guaranteed on the whole band (Singhose 2009 eq. 18).
-    Si(specified::SiSpec),
-    /// Several modes at once: the shortest shaper with zero vibration (and derivatives) at every
-    /// mode, designed directly instead of by convolution (Singer & Seering 1988 §2.3).
-    Direct(direct::DirectSpec),
+crate::tagged::tagged_enum! {
+    tag = "family", rename_all = "lowercase", mirror = shaper_spec_serde;
+    /// A family of shapers and its parameters (the `family` field selects the variant).
+    #[derive(Debug, Clone, PartialEq)]
+    pub enum ShaperSpec {
+        /// Zero vibration: 2 impulses, ½ damped period (Singhose 2009 eqs. 14–15).
+        Zv,
+        /// Zero vibration and derivative: 3 impulses, 1 period (Singhose 2009 eq. 17).
+        Zvd,
+        /// Zero vibration and two derivatives: 4 impulses, 1½ periods (Singer & Seering 1988).
+        Zvdd,
+        /// Zero vibration and `derivatives` derivatives: n + 2 impulses, (n+1)/2 periods.
+        Zvdn {
+            /// Number of zero derivatives n (0 = ZV, 1 = ZVD, …), at most
+            /// [`zero_vibration::MAX_DERIVATIVES`].
+            derivatives: u32,
+        },
+        /// Impulses on the controller period with a prescribed ramp delay and the least control
+        /// error (Kamel, Lange & Hirzinger); parameters in [`sampled::SampledSpec`].
+        Sampled(sampled::SampledSpec),
+        /// Extra-insensitive: V = `vtol` with zero slope at the mode (a hump), zeros either side;
+        /// 3 impulses, about 1 period (Singhose 2009 §3.1, Fig. 7), solved exactly with damping.
+        Ei {
+            /// Height of the hump, fraction (default 0.05 = 5 %), 0.001 … 0.5.
+            #[serde(default = "default_vtol")]
+            vtol: f64,
+        },
+        /// Two-hump EI: humps of height `vtol` either side of the mode, V = 0 at the mode;
+        /// 4 impulses, about 1½ periods.
+        Ei2 {
+            /// Height of the humps, fraction (default 0.05).
+            #[serde(default = "default_vtol")]
+            vtol: f64,
+        },
+        /// Three-hump EI: the middle hump at the mode; 5 impulses, about 2 periods.
+        Ei3 {
+            /// Height of the humps, fraction (default 0.05).
+            #[serde(default = "default_vtol")]
+            vtol: f64,
+        },
+        /// n-hump EI: `humps` humps of height `vtol`, n + 2 impulses, about (n+1)/2 periods.
+        Eihump {
+            /// Number of humps n, 1 … [`extra_insensitive::MAX_HUMPS`] (1 = EI).
+            humps: u32,
+            /// Height of the humps, fraction (default 0.05).
+            #[serde(default = "default_vtol")]
+            vtol: f64,
+        },
+        /// Klipper's modified ZV: 3 impulses over 0.75 damped period, V = 0 at the mode and near
+        /// 5/3 of it (Klipper shaper_defs.py).
+        Mzv,
+        /// Unity-magnitude ZV: [1, −1, 1], V = 0 at the mode; T/3 long at ζ = 0
+        /// (Singhose 2009 §5).
+        Umzv,
+        /// Unity-magnitude ZVD: [1, −1, 1, −1, 1], V = 0 and dV/dω = 0 at the mode.
+        Umzvd,
+        /// Unity-magnitude EI: [1, −1, 1, −1, 1], a hump V = `vtol` at the mode.
+        Umei {
+            /// Height of the hump, fraction (default 0.05).
+            #[serde(default = "default_vtol")]
+            vtol: f64,
+        },
+        /// Time-optimal rest-to-rest move of one flexible mode plus rigid body: [1, −2, 2, −2, 1],
+        /// amplitudes sum to 0 — convolve with a step of height `maxAcceleration` (Singhose 2009
+        /// Fig. 13).
+        #[serde(rename_all = "camelCase")]
+        Bangbang {
+            /// Move distance (any length unit).
+            distance: f64,
+            /// Actuator acceleration limit (same length unit per s²).
+            max_acceleration: f64,
+        },
+        /// Fuel-efficient on/off move: [1, −1, 1, −1, −1, 1, −1, 1] with a coast (Singhose 2009
+        /// Fig. 14); amplitudes sum to 0, applied like `bangbang`.
+        #[serde(rename_all = "camelCase")]
+        Onoff {
+            /// Move distance (any length unit).
+            distance: f64,
+            /// Actuator acceleration limit (same length unit per s²).
+            max_acceleration: f64,
+            /// Time with the actuator off between accelerating and decelerating, s (> 0).
+            coast_time: f64,
+        },
+        /// Your own impulses `[{ time, amplitude }]`, validated; the modes are not used.
+        Custom {
+            /// The impulses, any order (merged when at the same time, shifted to start at 0).
+            impulses: Vec<crate::shaper::Impulse>,
+            /// Divide the amplitudes by their sum (default false).
+            #[serde(default)]
+            normalize: bool,
+        },
+        /// Specified insensitivity: the shortest shaper with V ≤ Vtol over a band of frequencies
+        /// (and dampings), sampled or guaranteed on the whole band (Singhose 2009 eq. 18).
+        Si(specified::SiSpec),
+        /// Several modes at once: the shortest shaper with zero vibration (and derivatives) at every
+        /// mode, designed directly instead of by convolution (Singer & Seering 1988 §2.3).
+        Direct(direct::DirectSpec),
+    }
 }
 
 fn default_vtol() -> f64 {
@@ -159,13 +161,39 @@ impl ShaperSpec {
 }
 
 /// A complete design request: the modes and the family with its parameters.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DesignRequest {
     /// The modes to suppress (at least one, none repeated).
     pub modes: Vec<ModeSpec>,
     /// The family and its parameters.
     #[serde(flatten)]
     pub shaper: ShaperSpec,
+}
+
+/// `{ modes, family, …parameters }`: from a JS object the modes and the spec are read from the
+/// same object ([`crate::tagged`]); from anything else through serde's `flatten`.
+impl<'de> Deserialize<'de> for DesignRequest {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        struct Modes {
+            modes: Vec<ModeSpec>,
+        }
+        #[derive(Deserialize)]
+        struct DesignRequest {
+            modes: Vec<ModeSpec>,
+            #[serde(flatten)]
+            shaper: ShaperSpec,
+        }
+        let (modes, shaper) = if !crate::tagged::ANY_DESERIALIZER || crate::tagged::is_js::<D>() {
+            let (Modes { modes }, shaper) =
+                crate::tagged::deserialize_flat(d, "struct DesignRequest")?;
+            (modes, shaper)
+        } else {
+            let DesignRequest { modes, shaper } = DesignRequest::deserialize(d)?;
+            (modes, shaper)
+        };
+        Ok(Self { modes, shaper })
+    }
 }
 
 /// One row of the family table: what the family is called and what it promises.

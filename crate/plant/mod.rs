@@ -18,28 +18,29 @@ pub mod two_mass;
 
 use crate::error::Result;
 use crate::mode::Mode;
-use serde::{Deserialize, Serialize};
 
 pub use modal::{ModalPlant, PlantModeSpec};
 pub use pendulum::{Pendulum, PendulumSpec};
 pub use two_mass::TwoMass;
 
-/// A plant as written in a spec (`{ kind, … }`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "camelCase")]
-pub enum PlantSpec {
-    /// `{ kind: "modal", modes: [{ frequencyHz, damping, participation? }] }`.
-    Modal {
-        /// The flexible modes.
-        modes: Vec<PlantModeSpec>,
-    },
-    /// `{ kind: "twoMass", baseMass, tipMass, stiffness, dampingCoefficient? }` (SI units).
-    TwoMass(TwoMass),
-    /// `{ kind: "pendulum", length, gravity?, damping?, initialAngle?, hoist? }`.
-    Pendulum(PendulumSpec),
-    /// `{ kind: "vecianaTestBed" }`: 1.2 Hz (ζ 0.012) and 3.4 Hz (ζ 0.013), equal
-    /// participation.
-    VecianaTestBed,
+crate::tagged::tagged_enum! {
+    tag = "kind", rename_all = "camelCase", mirror = plant_spec_serde;
+    /// A plant as written in a spec (`{ kind, … }`).
+    #[derive(Debug, Clone, PartialEq)]
+    pub enum PlantSpec {
+        /// `{ kind: "modal", modes: [{ frequencyHz, damping, participation? }] }`.
+        Modal {
+            /// The flexible modes.
+            modes: Vec<PlantModeSpec>,
+        },
+        /// `{ kind: "twoMass", baseMass, tipMass, stiffness, dampingCoefficient? }` (SI units).
+        TwoMass(TwoMass),
+        /// `{ kind: "pendulum", length, gravity?, damping?, initialAngle?, hoist? }`.
+        Pendulum(PendulumSpec),
+        /// `{ kind: "vecianaTestBed" }`: 1.2 Hz (ζ 0.012) and 3.4 Hz (ζ 0.013), equal
+        /// participation.
+        VecianaTestBed,
+    }
 }
 
 /// A validated plant.
