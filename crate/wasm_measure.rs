@@ -234,13 +234,50 @@ struct ChannelChoice {
 }
 
 mod serde_json_like {
-    use serde::Deserialize;
+    use serde::de::{self, Deserialize, Deserializer, Visitor};
+    use std::fmt;
+
     /// A channel by name or index.
-    #[derive(Deserialize)]
-    #[serde(untagged)]
     pub(super) enum ChannelKey {
         Index(usize),
         Name(String),
+    }
+
+    /// Read by hand rather than `#[serde(untagged)]`, whose buffered parser (serde's `Content`)
+    /// would be compiled into the wasm for this one field (see crate/tagged.rs).
+    impl<'de> Deserialize<'de> for ChannelKey {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            struct Key;
+            impl<'de> Visitor<'de> for Key {
+                type Value = ChannelKey;
+
+                fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                    f.write_str("a channel index (0, 1, …) or name")
+                }
+
+                fn visit_u64<E: de::Error>(self, v: u64) -> Result<ChannelKey, E> {
+                    usize::try_from(v)
+                        .map(ChannelKey::Index)
+                        .map_err(|_| E::invalid_value(de::Unexpected::Unsigned(v), &self))
+                }
+
+                fn visit_i64<E: de::Error>(self, v: i64) -> Result<ChannelKey, E> {
+                    match u64::try_from(v) {
+                        Ok(v) => self.visit_u64(v),
+                        Err(_) => Err(E::invalid_value(de::Unexpected::Signed(v), &self)),
+                    }
+                }
+
+                fn visit_str<E: de::Error>(self, v: &str) -> Result<ChannelKey, E> {
+                    Ok(ChannelKey::Name(v.to_string()))
+                }
+
+                fn visit_string<E: de::Error>(self, v: String) -> Result<ChannelKey, E> {
+                    Ok(ChannelKey::Name(v))
+                }
+            }
+            d.deserialize_any(Key)
+        }
     }
 }
 

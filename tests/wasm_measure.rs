@@ -46,6 +46,23 @@ fn parse_identify_recommend_round_trip() {
     let channels: js_sys::Array = get(&rec, "channels").dyn_into().unwrap();
     assert_eq!(channels.length(), 3);
     assert!(get(&channels.get(0), "values").is_instance_of::<Float64Array>());
+    // A channel by index reads the same channel as by name; anything else names the field.
+    let by_index = api::identify_modes(rec.clone(), js(r#"{"channel":0}"#)).unwrap();
+    assert_eq!(
+        get(&by_index, "channel").as_string().as_deref(),
+        Some("accel_x")
+    );
+    for bad in ["-1", "1.5", "true"] {
+        let e = api::identify_modes(rec.clone(), js(&format!(r#"{{"channel":{bad}}}"#)));
+        let e: js_sys::Error = e.unwrap_err().dyn_into().unwrap();
+        let message = String::from(e.message());
+        assert_eq!(
+            get(&e, "field").as_string().as_deref(),
+            Some("options.channel"),
+            "{message}"
+        );
+        assert!(message.contains("channel index"), "{bad}: {message}");
+    }
     let id = api::identify_modes(rec, js(r#"{"channel":"accel_x"}"#)).unwrap();
     assert_eq!(get(&id, "channel").as_string().as_deref(), Some("accel_x"));
     let modes: js_sys::Array = get(&id, "modes").dyn_into().unwrap();
