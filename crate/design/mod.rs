@@ -171,7 +171,7 @@ pub struct DesignRequest {
 }
 
 /// `{ modes, family, …parameters }`: from a JS object the modes and the spec are read from the
-/// same object ([`crate::tagged`]); from anything else through serde's `flatten`.
+/// same object (`crate/tagged.rs`); from anything else through serde's `flatten`.
 impl<'de> Deserialize<'de> for DesignRequest {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         #[derive(Deserialize)]
