@@ -156,14 +156,11 @@ impl<'de> Deserialize<'de> for ShaperRequest {
             #[serde(flatten)]
             shaper: ShaperSpec,
         }
-        let (modes, shaper) = if !crate::tagged::ANY_DESERIALIZER || crate::tagged::is_js::<D>() {
-            let (Modes { modes }, shaper) =
-                crate::tagged::deserialize_flat(d, "struct ShaperRequest")?;
-            (modes, shaper)
-        } else {
-            let ShaperRequest { modes, shaper } = ShaperRequest::deserialize(d)?;
-            (modes, shaper)
-        };
+        let (Modes { modes }, shaper) =
+            crate::tagged::deserialize_flat(d, "struct ShaperRequest", |d| {
+                let ShaperRequest { modes, shaper } = ShaperRequest::deserialize(d)?;
+                Ok((Modes { modes }, shaper))
+            })?;
         Ok(Self { modes, shaper })
     }
 }

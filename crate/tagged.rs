@@ -25,8 +25,12 @@ pub(crate) const TAGGED: &str = "\0input-shaping tagged enum";
 /// with a flattened enum reads its own fields and then the enum from one object.
 pub(crate) const SAME: &str = "\0input-shaping same value";
 
-/// Whether `D` is the JS deserializer. Only asked where a value may come from another
-/// deserializer too (see [`ANY_DESERIALIZER`]).
+/// Whether `D` is the JS deserializer. Asked at run time, so it cannot leave the other branch
+/// out of the wasm: where a value may only come from JS (the wasm without the
+/// `any-deserializer` feature, on by default and off in the page's build), the fallback is
+/// compiled out instead (`#[cfg]` in [`deserialize`] and [`deserialize_flat`]), or serde's
+/// buffering would come back whole.
+#[cfg(any(not(target_arch = "wasm32"), feature = "any-deserializer"))]
 #[inline(always)]
 #[cfg_attr(
     not(target_arch = "wasm32"),
@@ -42,15 +46,6 @@ pub(crate) fn is_js<'de, D: Deserializer<'de>>() -> bool {
         false
     }
 }
-
-/// Whether the enums also read from deserializers other than the JS one: always natively; in
-/// the wasm with the `any-deserializer` feature (on by default, off in the page's build). The
-/// fallback must be left out of the page's wasm, not just skipped: compiled in, serde's
-/// buffering comes back whole, since the check above is made at run time.
-pub(crate) const ANY_DESERIALIZER: bool = cfg!(any(
-    not(target_arch = "wasm32"),
-    feature = "any-deserializer"
-));
 
 struct External<E, T> {
     expecting: &'static str,
@@ -70,8 +65,12 @@ impl<'de, E: Deserialize<'de> + Into<T>, T> Visitor<'de> for External<E, T> {
 }
 
 /// Reads an internally tagged enum `T`: through its externally tagged copy `E` from a JS
-/// value, through its internally tagged copy `I` from anything else ([`ANY_DESERIALIZER`]).
+/// value, through its internally tagged copy `I` from anything else (see [`is_js`]).
 /// `tag` is `[tag name]`.
+#[cfg_attr(
+    all(target_arch = "wasm32", not(feature = "any-deserializer")),
+    allow(clippy::extra_unused_type_parameters)
+)]
 pub(crate) fn deserialize<'de, D, E, I, T>(
     deserializer: D,
     tag: &'static [&'static str],
@@ -113,19 +112,28 @@ impl<'de, A: Deserialize<'de>, B: Deserialize<'de>> Visitor<'de> for Pair<A, B> 
     }
 }
 
-/// Reads a struct with one flattened field from a JS value as `(A, B)`: `A` the struct's own
-/// fields, `B` the flattened one, both from the same object (no buffering). Call it only for
-/// the JS deserializer (`!ANY_DESERIALIZER || is_js::<D>()`); other deserializers use serde's
-/// `#[serde(flatten)]` on a copy of the struct.
+/// Reads a struct with one flattened field as `(A, B)`: from a JS value, `A` the struct's own
+/// fields and `B` the flattened one, both from the same object (no buffering); from anything
+/// else (see [`is_js`]), through `fallback`, serde's `#[serde(flatten)]` on a copy of the
+/// struct.
+#[cfg_attr(
+    all(target_arch = "wasm32", not(feature = "any-deserializer")),
+    allow(unused_variables)
+)]
 pub(crate) fn deserialize_flat<'de, D, A, B>(
     deserializer: D,
     expecting: &'static str,
+    fallback: impl FnOnce(D) -> Result<(A, B), D::Error>,
 ) -> Result<(A, B), D::Error>
 where
     D: Deserializer<'de>,
     A: Deserialize<'de>,
     B: Deserialize<'de>,
 {
+    #[cfg(any(not(target_arch = "wasm32"), feature = "any-deserializer"))]
+    if !is_js::<D>() {
+        return fallback(deserializer);
+    }
     deserializer.deserialize_tuple_struct(SAME, 2, Pair::<A, B>(expecting, PhantomData))
 }
 

@@ -184,14 +184,11 @@ impl<'de> Deserialize<'de> for DesignRequest {
             #[serde(flatten)]
             shaper: ShaperSpec,
         }
-        let (modes, shaper) = if !crate::tagged::ANY_DESERIALIZER || crate::tagged::is_js::<D>() {
-            let (Modes { modes }, shaper) =
-                crate::tagged::deserialize_flat(d, "struct DesignRequest")?;
-            (modes, shaper)
-        } else {
-            let DesignRequest { modes, shaper } = DesignRequest::deserialize(d)?;
-            (modes, shaper)
-        };
+        let (Modes { modes }, shaper) =
+            crate::tagged::deserialize_flat(d, "struct DesignRequest", |d| {
+                let DesignRequest { modes, shaper } = DesignRequest::deserialize(d)?;
+                Ok((Modes { modes }, shaper))
+            })?;
         Ok(Self { modes, shaper })
     }
 }
