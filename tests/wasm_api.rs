@@ -178,7 +178,7 @@ fn errors_inside_tagged_specs_name_the_field() {
         let (message, got) = error_message(wasm::simulate(js(spec)).unwrap_err());
         assert_eq!(got.as_deref(), Some(*field), "{spec}: {message}");
     }
-    // The same spec reads as before once it is right.
+    // The same spec reads as before once it is right: EI has 3 impulses (Singhose 2009 §3.1).
     let shaper = wasm::design(js(&format!(r#"{{"family":"ei","vtol":0.05,{modes}}}"#))).unwrap();
     assert_eq!(
         get(&shaper, "impulses")
