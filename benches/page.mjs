@@ -1,7 +1,9 @@
 // Page benchmark (not a test): time full updates of the playground in headless Chromium —
 // recompute everything and redraw every chart (impulses, V(f), V(ζ), the map, the simulated
 // response, the command, its spectrum, robustness), as one input event does — with 3 modes and
-// 4 compared shapers, and report p50 / p95 / max in ms, plus the shipped size (gzip).
+// 4 compared shapers, and report p50 / p95 / max in ms, plus the shipped size (gzip -9 of every
+// file the browser fetched: on the first load, and then for opening a recording, which fetches
+// the measured-data worker and its module).
 // Two kinds of edit: a mode's frequency (every shaper redesigned and every chart recomputed;
 // the robustness background is cached per damping ratio and Vtol, so a frequency edit only
 // rescales it) and the mismatch r (the designs stay; the simulation and its charts change).
@@ -12,7 +14,7 @@
 // Run: npm run bench:page   (after npm run build); RUNS=n sets the updates per case (200),
 // SHAPERS=1 or SHAPERS=4 runs only the cases with that many shapers.
 import { chromium } from 'playwright-core';
-import { readFileSync, readdirSync } from 'node:fs';
+import { readFileSync } from 'node:fs';
 import { gzipSync } from 'node:zlib';
 import { startServer } from '../scripts/serve.mjs';
 
@@ -37,8 +39,12 @@ const browser = await chromium.launch({
 });
 try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const fetched = new Set();
+  page.on('request', (r) => fetched.add(new URL(r.url()).pathname));
   await page.goto(`${url}#state=${encodeURIComponent(JSON.stringify(state))}`);
   await page.waitForSelector('body[data-ready="true"]');
+  await page.waitForLoadState('networkidle');
+  const firstLoad = [...fetched];
   const charts = await page.$$eval('.charts canvas', (c) => c.length);
   const cases = [[4, 'mode'], [4, 'mismatch'], [1, 'mode'], [1, 'mismatch']]
     .filter(([n]) => !process.env.SHAPERS || Number(process.env.SHAPERS) === n);
@@ -65,15 +71,28 @@ try {
     const q = (p) => times[Math.min(times.length - 1, Math.floor(p * times.length))];
     console.log(`full update after a ${edit} edit, 3 modes, ${shapers === 4 ? '4 shapers (ZV, ZVD, ZVDD, ZV-D³: 8 … 125 impulses)' : '1 shaper (ZVD, 27 impulses)'}, ${charts} charts (${RUNS} runs): p50 ${q(0.5).toFixed(2)} ms, p95 ${q(0.95).toFixed(2)} ms, max ${times[times.length - 1].toFixed(2)} ms (budget: p95 16 ms)`);
   }
+  // Open a recording (2 s of a 40 Hz decay at 3200 Hz): the page starts the measured-data
+  // worker, which fetches its script and module.
+  const rows = ['time,accel_x'];
+  for (let k = 0; k < 6400; k++) rows.push(`${(k / 3200).toFixed(6)},${(1000 * Math.exp(-7.5 * (k % 3200) / 3200) * Math.sin(2 * Math.PI * 40 * k / 3200)).toFixed(4)}`);
+  await page.setInputFiles('#measure-file', { name: 'decay.csv', mimeType: 'text/csv', buffer: Buffer.from(rows.join('\n')) });
+  await page.waitForFunction(() => document.getElementById('measure-file-name').textContent !== ''
+    || document.getElementById('measure-error').textContent !== '');
+  await page.waitForLoadState('networkidle');
+  const measured = [...fetched].filter((f) => !firstLoad.includes(f));
+  report('shipped on the first load', firstLoad, '(budget: 300 KB)');
+  report('fetched when a recording is opened', measured, '(the measured-data worker)');
 } finally {
   await browser.close();
   server.close();
 }
 
-const root = new URL('..', import.meta.url);
-const files = [
-  'pkg/input_shaping_bg.wasm', 'pkg/input_shaping.js', 'index.html',
-  ...readdirSync(new URL('web/', root)).map((f) => `web/${f}`),
-];
-const gz = files.reduce((sum, f) => sum + gzipSync(readFileSync(new URL(f, root)), { level: 9 }).length, 0);
-console.log(`shipped (wasm + JS + HTML + CSS): ${(gz / 1024).toFixed(1)} KiB gzip (budget: 300 KB)`);
+/** Prints the gzip -9 size of the files at `paths` (URL paths under the repository root). */
+function report(what, paths, note) {
+  const root = new URL('..', import.meta.url);
+  const files = paths.filter((f) => f !== '/' && !f.startsWith('/favicon')).concat(paths.includes('/') ? ['/index.html'] : []);
+  const sizes = files.map((f) => [f, gzipSync(readFileSync(new URL(`.${f}`, root)), { level: 9 }).length]);
+  const total = sizes.reduce((sum, [, n]) => sum + n, 0);
+  console.log(`${what}: ${(total / 1024).toFixed(1)} KiB gzip (${(total / 1000).toFixed(1)} KB) ${note}`);
+  for (const [f, n] of sizes.sort((a, b) => b[1] - a[1])) console.log(`  ${(n / 1024).toFixed(1).padStart(7)} KiB  ${f}`);
+}

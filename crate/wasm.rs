@@ -1,6 +1,10 @@
 //! The JavaScript API: thin glue between the page and the core. Objects cross the boundary as
 //! plain JSON-like values (camelCase) through serde-wasm-bindgen; every error is thrown as a JS
 //! `Error` whose message starts with the offending field and whose `field` property holds it.
+//!
+//! Each export belongs to a Cargo feature (`js-api`, `js-playground`, `js-recording`; see
+//! Cargo.toml). A build with only some of them leaves helpers unused, hence the allow there.
+#![cfg_attr(not(feature = "js-api"), allow(dead_code, unused_imports))]
 
 use crate::canvas::Canvas;
 use crate::chart::{self, ChartStyle};
@@ -91,6 +95,7 @@ fn mode_from_js(value: JsValue, what: &str) -> Result<Mode, Error> {
 
 /// `design(spec)`: `spec = { family, modes: [{ frequencyHz, damping }], …parameters }` →
 /// `{ impulses: [{ time, amplitude }], duration }`.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn design(spec: JsValue) -> Result<JsValue, JsValue> {
     let request: DesignRequest = from_js(spec, "").map_err(js_error)?;
@@ -99,6 +104,7 @@ pub fn design(spec: JsValue) -> Result<JsValue, JsValue> {
 }
 
 /// `residualVibration(shaper, { frequencyHz, damping })` → V as a fraction (1 = unshaped).
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = residualVibration)]
 pub fn residual_vibration(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
@@ -108,6 +114,7 @@ pub fn residual_vibration(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue
 
 /// `sensitivity(shaper, { fromHz, toHz, points, damping })` →
 /// `{ frequencyHz: number[], vibration: number[] }`.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
@@ -118,6 +125,7 @@ pub fn sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue
 
 /// `insensitivity(shaper, { frequencyHz, damping }, vtol)` → `{ lowHz, highHz, width }`, the
 /// band around the mode where V ≤ vtol, width as a fraction of `frequencyHz`.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn insensitivity(shaper: JsValue, mode: JsValue, vtol: f64) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
@@ -142,6 +150,7 @@ pub(crate) fn set(object: &js_sys::Object, key: &str, value: &JsValue) -> Result
 /// V on the frequency × damping grid, `vibration` row-major with one row per damping value
 /// (`vibration[k * frequencyHz.length + j]` is V at `damping[k]`, `frequencyHz[j]`). The grid
 /// is returned as a typed array because copying it is far cheaper than building a JS array.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = sensitivityMap)]
 pub fn sensitivity_map(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
@@ -158,6 +167,7 @@ pub fn sensitivity_map(shaper: JsValue, options: JsValue) -> Result<JsValue, JsV
 
 /// `dampingSensitivity(shaper, { frequencyHz, fromDamping, toDamping, points })` →
 /// `{ damping: number[], vibration: number[] }`: V over damping ratios at one frequency.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = dampingSensitivity)]
 pub fn damping_sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
@@ -170,6 +180,7 @@ pub fn damping_sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue,
 /// `dampingInsensitivity(shaper, { frequencyHz, damping }, vtol)` →
 /// `{ lowDamping, highDamping, width }`: the band of damping ratios around the mode's where
 /// V ≤ vtol at the mode's frequency; `width = highDamping − lowDamping`.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = dampingInsensitivity)]
 pub fn damping_insensitivity(
     shaper: JsValue,
@@ -187,6 +198,7 @@ pub fn damping_insensitivity(
 /// the mode, its duration in periods and its insensitivities (Singhose 2009 Fig. 11).
 /// `specs` is an array of `{ family, …parameters }`; without it, every family that needs no
 /// parameters.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = robustnessTable)]
 pub fn robustness_table(mode: JsValue, vtol: f64, specs: JsValue) -> Result<JsValue, JsValue> {
     let mode = mode_from_js(mode, "mode").map_err(js_error)?;
@@ -200,6 +212,7 @@ pub fn robustness_table(mode: JsValue, vtol: f64, specs: JsValue) -> Result<JsVa
 }
 
 /// `families()` → the table of shaper families: `[{ name, title, guarantee, parameters, source }]`.
+#[cfg(feature = "js-playground")]
 #[wasm_bindgen]
 pub fn families() -> Result<JsValue, JsValue> {
     to_js(&design::FAMILIES)
@@ -761,6 +774,7 @@ fn analysis(
 /// (`shapers[1].vtol`, `modes[0].damping`, `view.vtol`, `view.mismatch`,
 /// `view.command.maxVelocity`). Nothing is drawn unless everything computed, so a bad input
 /// leaves the last good charts on screen.
+#[cfg(feature = "js-playground")]
 #[wasm_bindgen(js_name = renderPlayground)]
 pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, JsValue> {
     let state: PlaygroundState = from_js(state, "").map_err(js_error)?;
@@ -1095,6 +1109,7 @@ struct ExportOptions {
 /// (float arrays `<name>_time_s`, `<name>_amplitude`), `"cFixed"` (integer amplitudes in
 /// 1/`amplitudeSteps` and times in ticks of `tickS`), `"rrf"` (RepRapFirmware 3.6+
 /// `M593 P"custom"` line).
+#[cfg(feature = "js-playground")]
 #[wasm_bindgen(js_name = exportShaper)]
 pub fn export_shaper(shaper: JsValue, options: JsValue) -> Result<String, JsValue> {
     use crate::export;
@@ -1129,6 +1144,7 @@ pub fn export_shaper(shaper: JsValue, options: JsValue) -> Result<String, JsValu
 /// (smoothing in mm at 5000 mm/s², suggested max acceleration in mm/s² at 0.12 mm smoothing;
 /// `scv` is the square corner velocity in mm/s, default 5). `maxAccel` is `null` for a single
 /// impulse (unbounded).
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = klipperFigures)]
 pub fn klipper_figures(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     #[derive(Deserialize)]
@@ -1152,6 +1168,7 @@ pub fn klipper_figures(shaper: JsValue, options: JsValue) -> Result<JsValue, JsV
 
 /// `rampDelay(shaper, { frequencyHz, damping })` → τ = 2ζ/ω + Σ Aᵢtᵢ / Σ Aᵢ in seconds, the lag
 /// of the plant's response to a slow ramp (Kamel, Lange & Hirzinger eq. 10).
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = rampDelay)]
 pub fn ramp_delay(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
@@ -1163,6 +1180,7 @@ pub fn ramp_delay(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue> {
 /// rampDelay, cost: { total, controlError, amplitudePenalty }, baselineCost, costReduction }`:
 /// the design `design(spec)` returns plus its ramp delay (eq. 10) and cost J_q (eq. 17), and the
 /// cost of the minimum-norm shaper under the same constraints.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = sampledReport)]
 pub fn sampled_report(spec: JsValue) -> Result<JsValue, JsValue> {
     let request: DesignRequest = from_js(spec, "").map_err(js_error)?;
@@ -1184,6 +1202,7 @@ pub fn sampled_report(spec: JsValue) -> Result<JsValue, JsValue> {
 /// vtol? })` → `{ impulses, duration, amplitudeSum, vtol, vibrationBefore, vibrationAfter,
 /// insensitivityBefore, insensitivityAfter }`: the shaper rounded for an integer controller
 /// (Peláez & Singhose 2002) and what rounding cost at the mode.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn quantize(shaper: JsValue, mode: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
@@ -1199,6 +1218,7 @@ pub fn quantize(shaper: JsValue, mode: JsValue, options: JsValue) -> Result<JsVa
 /// sampleRateHz? }` → `{ time, unshaped: { basePosition, baseVelocity, baseAcceleration,
 /// endpoint, endpointVelocity, endpointAcceleration, deflection, swingAngle?, metrics },
 /// shaped (same, or null), shaper, modesHz, samplePeriod }`. See the README for every field.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn simulate(spec: JsValue) -> Result<JsValue, JsValue> {
     let spec: crate::simulate::SimulationSpec = from_js(spec, "").map_err(js_error)?;
@@ -1209,6 +1229,7 @@ pub fn simulate(spec: JsValue) -> Result<JsValue, JsValue> {
 /// `spectrum(spec)`: `spec = { command, shaper? | impulses?, plant?, fromHz?, toHz?, points?,
 /// signal? }` → `{ frequencyHz, magnitude, unshaped, modesHz }` (|U(f)| of the shaped and the
 /// unshaped command's velocity by default).
+#[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn spectrum(spec: JsValue) -> Result<JsValue, JsValue> {
     let spec: crate::spectrum::SpectrumSpec = from_js(spec, "").map_err(js_error)?;

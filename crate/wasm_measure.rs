@@ -3,6 +3,10 @@
 //! cross the boundary as `Float64Array`s (copying 10⁶ numbers into a typed array is far cheaper
 //! than building a JS array). Errors are JS `Error`s with `kind` and `field` as in `wasm.rs`;
 //! recording errors also carry `line` and `column` (1-based) and `columnName`.
+//!
+//! Each export belongs to a Cargo feature (`js-api`, `js-playground`, `js-recording`; see
+//! Cargo.toml). A build with only some of them leaves helpers unused, hence the allow there.
+#![cfg_attr(not(feature = "js-api"), allow(dead_code, unused_imports))]
 
 use crate::canvas::Canvas;
 use crate::chart::{self, ChartStyle};
@@ -126,6 +130,7 @@ fn psd_to_js(psd: &Psd) -> Result<JsValue, JsValue> {
 /// timeColumn, sampleRateHz, startTimeS, durationS, rows, resampled, timing: { meanStepS,
 /// minStepS, maxStepS, jitter }, channels: [{ name, values: Float64Array }] }`. Errors carry
 /// `line`, `column`, `columnName`.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = parseRecording)]
 pub fn parse_recording(text: &str, options: JsValue) -> Result<JsValue, JsValue> {
     let options: RecordingOptions = self::options(options, "options").map_err(js_error)?;
@@ -136,11 +141,13 @@ pub fn parse_recording(text: &str, options: JsValue) -> Result<JsValue, JsValue>
 /// `new RecordingParser({ timeColumn?, timeScale? })`: reads a recording in chunks —
 /// `push(text)` any number of times (lines may span chunks), then `finish()` → the same object
 /// as `parseRecording`. `lines` and `rows` say how far it got (for a progress bar).
+#[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = RecordingParser)]
 pub struct JsRecordingParser {
     inner: Option<recording::RecordingParser>,
 }
 
+#[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_class = RecordingParser)]
 impl JsRecordingParser {
     /// A parser with the options of `parseRecording`.
@@ -191,6 +198,7 @@ impl JsRecordingParser {
 /// segmentLength, overlap, segments, resolutionHz, enbwBins, sampleRateHz }`; `signal` is a
 /// `Float64Array` or an array of numbers. `{ preset: 'klipper', sampleRateHz }` takes
 /// Klipper's settings instead.
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = welch)]
 pub fn welch_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     let x = f64_vec(&signal, "signal").map_err(js_error)?;
@@ -207,6 +215,7 @@ pub fn welch_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
 
 /// `fftSpectrum(signal, { sampleRateHz, window?, kaiserBeta?, detrend? })` → `{ frequencyHz,
 /// magnitude (Float64Array), resolutionHz }`: the amplitude spectrum of the whole record.
+#[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = fftSpectrum)]
 pub fn fft_spectrum_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     let x = f64_vec(&signal, "signal").map_err(js_error)?;
@@ -289,6 +298,7 @@ mod serde_json_like {
 /// → `{ channel, modes: [{ frequencyHz, damping, frequencyUncertaintyHz, dampingUncertainty,
 /// method, peakFrequencyHz, peakPsd, prominenceDb, estimates: [...] }], spectrum: { frequencyHz,
 /// psd, … }, detectionSegmentLength, bandHz, freeDecay: { startS, endS, levelDb } | null }`.
+#[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = identifyModes)]
 pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     let is_signal = recording.is_instance_of::<js_sys::Float64Array>()
@@ -376,6 +386,7 @@ pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, J
 /// ranked: [{ label, family, spec, modes, shaper, durationS, remainingVibration,
 /// nominalRemainingVibration, smoothing, maxAccel, klipperScore, acceptable }], dampingTested,
 /// frequencyFactors, bandHz }`.
+#[cfg(feature = "js-playground")]
 #[wasm_bindgen(js_name = recommendShaper)]
 pub fn recommend_shaper(
     spectrum: JsValue,
@@ -407,6 +418,7 @@ struct DrawOptions {
 /// `spectrum = { frequencyHz, psd }` in dB (10·log₁₀ psd) on the canvas with a labelled marker
 /// at each of `peaksHz`; `title` / `yLabel` default to "Measured spectrum (Welch PSD)" /
 /// "PSD (dB)" (pass |X|² as `psd` to draw an FFT magnitude in dB).
+#[cfg(feature = "js-playground")]
 #[wasm_bindgen(js_name = drawSpectrum)]
 pub fn draw_spectrum(
     canvas: HtmlCanvasElement,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Builds the release wasm and its JS bindings into pkg/ (wasm-bindgen --target web), then
-# shrinks the wasm with npm's binaryen (Debian's wasm-opt 108 breaks it; see README).
+# Builds the release wasm modules and their JS bindings into pkg/ (wasm-bindgen --target web),
+# then shrinks each wasm with npm's binaryen (Debian's wasm-opt 108 breaks it; see README).
 #
 # The wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
 # library with the crate (-Z build-std) at the release profile's opt-level "z" and LTO, with
@@ -16,31 +16,64 @@ export PATH="$HOME/.cargo/bin:$PATH"
 
 nightly=$(bash scripts/nightly.sh)
 target=wasm32-unknown-unknown
-dir=
+use_nightly=0
 if [ "${STABLE:-0}" != 1 ] && sysroot=$(rustup run "$nightly" rustc --print sysroot 2>/dev/null) \
   && [ -d "$sysroot/lib/rustlib/src/rust/library" ]; then
-  # Its own target directory: other RUSTFLAGS and std would rebuild the stable builds' cache.
-  if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build --release --lib --target "$target" --no-default-features \
-    --target-dir target/shipped -Z build-std=std,panic_abort; then
-    dir=target/shipped
-    how="$nightly, std built for size"
-  else
-    echo "[build] the $nightly build failed: building with stable Rust instead (larger wasm)" >&2
+  use_nightly=1
+fi
+
+# Three modules from one crate, each with the exports of some Cargo features (Cargo.toml):
+#   pkg/input_shaping.js          the whole JavaScript API (README), for programs of your own;
+#   pkg/page/playground.js        what the page's main thread calls (js-playground);
+#   pkg/page/recording.js         what its measured-data worker calls (js-recording), fetched
+#                                 only when a recording is opened.
+# The linker keeps only the code an export reaches, so the page's modules are smaller than the
+# whole API's (README, *Shipped size*). The same sources, the same results.
+# build_module FEATURES OUT_DIR OUT_NAME
+build_module() {
+  local features=$1 out=$2 name=$3 dir=""
+  if [ "$use_nightly" = 1 ]; then
+    # Its own target directory: other RUSTFLAGS and std would rebuild the stable builds' cache.
+    if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build --release --lib --target "$target" \
+      --no-default-features --features "$features" --target-dir target/shipped -Z build-std=std,panic_abort; then
+      dir=target/shipped
+      how="$nightly, std built for size"
+    else
+      echo "[build] the $nightly build failed: building with stable Rust instead (larger wasm)" >&2
+      use_nightly=0
+    fi
   fi
-fi
-if [ -z "$dir" ]; then
-  dir=target
-  cargo build --release --lib --target "$target" --no-default-features
-  how="stable Rust, prebuilt std: larger"
-fi
+  if [ -z "$dir" ]; then
+    dir=target
+    cargo build --release --lib --target "$target" --no-default-features --features "$features"
+    how="stable Rust, prebuilt std: larger"
+  fi
+  rm -rf "$out/$name.js" "$out/${name}_bg.wasm"
+  wasm-bindgen --target web --out-dir "$out" --out-name "$name" --remove-producers-section \
+    "$dir/$target/release/input_shaping.wasm"
+}
+
+# Each module's wasm-opt runs in the background while the next one compiles.
+shrink() {
+  local wasm=$1
+  if [ -x node_modules/.bin/wasm-opt ]; then
+    node_modules/.bin/wasm-opt -Oz --converge --one-caller-inline-max-function-size 0 "$wasm" -o "$wasm.opt" \
+      && mv "$wasm.opt" "$wasm"
+  fi
+}
+
 rm -rf pkg
-wasm-bindgen --target web --out-dir pkg --out-name input_shaping --remove-producers-section \
-  "$dir/$target/release/input_shaping.wasm"
-wasm=pkg/input_shaping_bg.wasm
-if [ -x node_modules/.bin/wasm-opt ]; then
-  node_modules/.bin/wasm-opt -Oz --converge --one-caller-inline-max-function-size 0 "$wasm" -o "$wasm.opt" && mv "$wasm.opt" "$wasm"
-fi
-raw=$(wc -c < "$wasm")
-gz=$(gzip -9 -c "$wasm" | wc -c)
-jsgz=$(gzip -9 -c pkg/input_shaping.js | wc -c)
-printf '[build] pkg/input_shaping_bg.wasm (%s): %d bytes (%d gzip); glue JS %d bytes gzip\n' "$how" "$raw" "$gz" "$jsgz"
+pids=()
+build_module js-api pkg input_shaping
+shrink pkg/input_shaping_bg.wasm & pids+=($!)
+build_module js-playground pkg/page playground
+shrink pkg/page/playground_bg.wasm & pids+=($!)
+build_module js-recording pkg/page recording
+shrink pkg/page/recording_bg.wasm & pids+=($!)
+for pid in "${pids[@]}"; do wait "$pid"; done
+
+gz() { gzip -9 -c "$1" | wc -c; }
+for m in pkg/input_shaping pkg/page/playground pkg/page/recording; do
+  printf '[build] %s_bg.wasm (%s): %d bytes (%d gzip); glue JS %d bytes gzip\n' \
+    "$m" "$how" "$(wc -c < "${m}_bg.wasm")" "$(gz "${m}_bg.wasm")" "$(gz "$m.js")"
+done

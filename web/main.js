@@ -2,7 +2,7 @@
 // frame (renderPlayground), and the numbers, charts and exports of the last good result. A bad
 // value shows its message next to its field (matched by the error's `field` against the
 // inputs' data-field) while the last good charts and numbers stay.
-import init, { renderPlayground, families, exportShaper } from '../pkg/input_shaping.js';
+import init, { renderPlayground, families, exportShaper } from '../pkg/page/playground.js';
 import { DEFAULT_STATE, PRESETS, MAX_MODES, MAX_SHAPERS, checkState, clone, toHash, fromHash } from './state.js';
 import { COMMAND_PARAMS, commandFor } from './params.js';
 import { paramInfo, parseParam, formatParam } from './params.js';

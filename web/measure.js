@@ -1,8 +1,10 @@
 // Measured data (issue 7): load a recording, show its spectrum with the detected peaks, the
 // identified modes with their uncertainties, and the ranked shaper recommendation. The reading
-// (in 1 MB chunks, with progress) and the analysis run in a worker (web/measure_worker.js), so
-// a 10⁶-row file never freezes the page; a bad file leaves the last good result on screen.
-import { drawSpectrum } from '../pkg/input_shaping.js';
+// (in 1 MB chunks, with progress) and the identification run in a worker (web/measure_worker.js),
+// so a 10⁶-row file never freezes the page; a bad file leaves the last good result on screen.
+// The worker and its module are fetched when the first file is opened, not with the page. The
+// ranking designs every candidate shaper, which the page's own module already can: it runs here.
+import { drawSpectrum, recommendShaper } from '../pkg/page/playground.js';
 
 const $ = (id) => document.getElementById(id);
 /** Largest file accepted (a 10⁷-row Klipper file is ~350 MB). */
@@ -46,6 +48,7 @@ function load(file) {
     return;
   }
   fileName = file.name;
+  startWorker();
   const progress = $('measure-progress');
   progress.value = 0;
   progress.hidden = false;
@@ -78,10 +81,28 @@ function onMessage({ data }) {
   } else if (data.type === 'result') {
     progress.hidden = true;
     fft = null;
-    show(data);
+    show({ ...data, recommendation: rank(data.identification) });
     if ($('measure-view').value === 'fft') requestFft();
     $('measure-file-name').textContent = fileName;
   }
+}
+
+/** The ranked shapers for the identified modes, or null (no mode, or none could be designed). */
+function rank(id) {
+  if (id.modes.length === 0) return null;
+  try {
+    return recommendShaper(id.spectrum, id.modes, {});
+  } catch (e) {
+    showError(`Could not rank the shapers for these modes: ${e?.message ?? e}`);
+    return null;
+  }
+}
+
+function startWorker() {
+  if (worker) return;
+  worker = new Worker(new URL('./measure_worker.js', import.meta.url), { type: 'module' });
+  worker.addEventListener('message', onMessage);
+  worker.addEventListener('error', (e) => showError(`The measurement worker failed: ${e.message ?? e}`));
 }
 
 function requestFft() {
@@ -162,9 +183,6 @@ function draw() {
 /** Wires the section; `hooks.acceptModes(modes)` puts modes into the playground's editor. */
 export function setupMeasure(hooks) {
   acceptModes = hooks.acceptModes;
-  worker = new Worker(new URL('./measure_worker.js', import.meta.url), { type: 'module' });
-  worker.addEventListener('message', onMessage);
-  worker.addEventListener('error', (e) => showError(`The measurement worker failed: ${e.message ?? e}`));
   const input = $('measure-file');
   input.addEventListener('change', () => {
     const file = input.files[0];

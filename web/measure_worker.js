@@ -1,9 +1,11 @@
-// The measured-data worker: reads a recording in chunks, identifies the modes and ranks the
-// shapers off the page's thread, so a 10⁶-row file never freezes the page. Messages in:
-// { id, type: 'load', file, options }, { id, type: 'analyse', options } and { id, type: 'fft',
-// channel }; out: progress, result ({ recording, identification, recommendation }), fft
-// ({ spectrum }) or error ({ message, line, column }).
-import init, { RecordingParser, identifyModes, recommendShaper, fftSpectrum } from '../pkg/input_shaping.js';
+// The measured-data worker: reads a recording in chunks and identifies its modes off the page's
+// thread, so a 10⁶-row file never freezes the page. Messages in: { id, type: 'load', file,
+// options }, { id, type: 'analyse', options } and { id, type: 'fft', channel }; out: progress,
+// result ({ recording, identification }), fft ({ spectrum }) or error ({ message, line,
+// column }). It loads its own small module (pkg/page/recording.js: parsing, spectra,
+// identification); the shaper ranking needs the designs, which the page's module has, so the
+// page ranks the identified modes itself (web/measure.js).
+import init, { RecordingParser, identifyModes, fftSpectrum } from '../pkg/page/recording.js';
 
 const CHUNK_BYTES = 1 << 20;
 const ready = init();
@@ -33,10 +35,7 @@ async function read(id, file) {
 function analyse(id, rec, options) {
   postMessage({ id, type: 'analysing', rows: rec.rows });
   const identification = identifyModes(rec, options);
-  const recommendation = identification.modes.length > 0
-    ? recommendShaper(identification.spectrum, identification.modes, {})
-    : null;
-  return { id, type: 'result', recording: summary(rec), identification, recommendation };
+  return { id, type: 'result', recording: summary(rec), identification };
 }
 
 onmessage = async ({ data }) => {

@@ -113,6 +113,25 @@ test('a recording is identified, its modes accepted into the editor, and a bad f
   await page.close();
 });
 
+test('the measured-data worker and its module are fetched when a recording is opened, not with the page', async () => {
+  const { page, problems } = await env.page();
+  const firstLoad = await page.evaluate(() => performance.getEntriesByType('resource').map((e) => new URL(e.name).pathname));
+  assert.ok(firstLoad.includes('/pkg/page/playground_bg.wasm'), firstLoad.join(' '));
+  for (const later of ['/pkg/page/recording_bg.wasm', '/web/measure_worker.js', '/pkg/input_shaping_bg.wasm']) {
+    assert.ok(!firstLoad.includes(later), `${later} is not fetched on the first load`);
+  }
+  const fetched = [];
+  page.on('request', (r) => fetched.push(new URL(r.url()).pathname));
+  await loadFile(page, 'resonances_x.csv', klipperFile(40_000));
+  await page.waitForSelector('#measure-modes tbody tr[data-mode]', { timeout: 120000 });
+  assert.ok(fetched.includes('/web/measure_worker.js') && fetched.includes('/pkg/page/recording_bg.wasm'), fetched.join(' '));
+  assert.ok(!fetched.includes('/pkg/input_shaping_bg.wasm'), 'the whole-API module is never fetched by the page');
+  // The ranking runs on the page's thread, with the page's module.
+  assert.match(await page.textContent('#measure-recommended'), /^Recommended: /);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('a 10^6-row file loads in chunks with progress shown', async () => {
   const { page, problems } = await env.page();
   // Count progress updates and the longest gap between timer ticks while loading.
