@@ -71,9 +71,13 @@ shrink pkg/page/playground_bg.wasm & pids+=($!)
 build_module js-recording pkg/page recording
 shrink pkg/page/recording_bg.wasm & pids+=($!)
 for pid in "${pids[@]}"; do wait "$pid"; done
+bash scripts/bundle.sh
 
 gz() { gzip -9 -c "$1" | wc -c; }
 for m in pkg/input_shaping pkg/page/playground pkg/page/recording; do
   printf '[build] %s_bg.wasm (%s): %d bytes (%d gzip); glue JS %d bytes gzip\n' \
     "$m" "$how" "$(wc -c < "${m}_bg.wasm")" "$(gz "${m}_bg.wasm")" "$(gz "$m.js")"
+done
+for b in pkg/page/main.js pkg/page/measure_worker.js; do
+  printf '[build] %s (esbuild): %d bytes gzip\n' "$b" "$(gz "$b")"
 done

@@ -117,14 +117,14 @@ test('the measured-data worker and its module are fetched when a recording is op
   const { page, problems } = await env.page();
   const firstLoad = await page.evaluate(() => performance.getEntriesByType('resource').map((e) => new URL(e.name).pathname));
   assert.ok(firstLoad.includes('/pkg/page/playground_bg.wasm'), firstLoad.join(' '));
-  for (const later of ['/pkg/page/recording_bg.wasm', '/web/measure_worker.js', '/pkg/input_shaping_bg.wasm']) {
+  for (const later of ['/pkg/page/recording_bg.wasm', '/pkg/page/measure_worker.js', '/pkg/input_shaping_bg.wasm']) {
     assert.ok(!firstLoad.includes(later), `${later} is not fetched on the first load`);
   }
   const fetched = [];
   page.on('request', (r) => fetched.push(new URL(r.url()).pathname));
   await loadFile(page, 'resonances_x.csv', klipperFile(40_000));
   await page.waitForSelector('#measure-modes tbody tr[data-mode]', { timeout: 120000 });
-  assert.ok(fetched.includes('/web/measure_worker.js') && fetched.includes('/pkg/page/recording_bg.wasm'), fetched.join(' '));
+  assert.ok(fetched.includes('/pkg/page/measure_worker.js') && fetched.includes('/pkg/page/recording_bg.wasm'), fetched.join(' '));
   assert.ok(!fetched.includes('/pkg/input_shaping_bg.wasm'), 'the whole-API module is never fetched by the page');
   // The ranking runs on the page's thread, with the page's module.
   assert.match(await page.textContent('#measure-recommended'), /^Recommended: /);

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Bundles and minifies the page's scripts (esbuild) next to its wasm modules, into pkg/page/:
+#   main.js            web/main.js with web/state.js, params.js, measure.js and the
+#                      playground module's glue (index.html loads it);
+#   measure_worker.js  web/measure_worker.js with the recording module's glue (started by
+#                      main.js when the first recording is opened).
+# Each glue finds its .wasm next to the bundle (new URL(…, import.meta.url)), so the bundles
+# live in pkg/page/ with them. Source maps point back to web/. Run by scripts/build.sh after
+# the wasm modules; alone (`npm run build:web`) after editing web/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+node_modules/.bin/esbuild web/main.js web/measure_worker.js --bundle --minify --format=esm \
+  --target=es2020 --sourcemap --outdir=pkg/page --log-level=warning
