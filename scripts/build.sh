@@ -2,7 +2,7 @@
 # Builds the release wasm modules and their JS bindings into pkg/ (wasm-bindgen --target web),
 # then shrinks each wasm with npm's binaryen (Debian's wasm-opt 108 breaks it; see README).
 #
-# The wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
+# Each wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
 # library with the crate (-Z build-std) at the release profile's opt-level "z" and LTO, with
 # panic locations left out (-Z location-detail=none; panic messages stay): same code, same
 # results, ~24 KB less gzip (README, *Shipped size*). std's `optimize_for_size` feature would
@@ -51,6 +51,7 @@ build_module() {
   rm -rf "$out/$name.js" "$out/${name}_bg.wasm"
   wasm-bindgen --target web --out-dir "$out" --out-name "$name" --remove-producers-section \
     "$dir/$target/release/input_shaping.wasm"
+  echo "[build] $out/$name.js ($features): built by $how"
 }
 
 # Each module's wasm-opt runs in the background while the next one compiles.
@@ -75,8 +76,8 @@ bash scripts/bundle.sh
 
 gz() { gzip -9 -c "$1" | wc -c; }
 for m in pkg/input_shaping pkg/page/playground pkg/page/recording; do
-  printf '[build] %s_bg.wasm (%s): %d bytes (%d gzip); glue JS %d bytes gzip\n' \
-    "$m" "$how" "$(wc -c < "${m}_bg.wasm")" "$(gz "${m}_bg.wasm")" "$(gz "$m.js")"
+  printf '[build] %s_bg.wasm: %d bytes (%d gzip); glue JS %d bytes gzip\n' \
+    "$m" "$(wc -c < "${m}_bg.wasm")" "$(gz "${m}_bg.wasm")" "$(gz "$m.js")"
 done
 for b in pkg/page/main.js pkg/page/measure_worker.js; do
   printf '[build] %s (esbuild): %d bytes gzip\n' "$b" "$(gz "$b")"
