@@ -440,8 +440,25 @@ function fromLocation({ startup = false } = {}) {
   loadState(s ?? clone(DEFAULT_STATE), { push: false });
 }
 
+/**
+ * The page's wasm module, compiled once: instantiated here and handed to the measured-data
+ * worker, which ranks shapers with it without fetching or compiling it again. This file runs as
+ * the bundle pkg/page/main.js (scripts/bundle.sh), beside the .wasm, as the glue inside it does.
+ */
+async function compileModule() {
+  const response = await fetch(new URL('playground_bg.wasm', import.meta.url));
+  if (!response.ok) throw new Error(`could not load the wasm module (HTTP ${response.status})`);
+  try {
+    return await WebAssembly.compileStreaming(response.clone());
+  } catch {
+    // Served without the application/wasm MIME type: compile from the bytes.
+    return WebAssembly.compile(await response.arrayBuffer());
+  }
+}
+
 async function main() {
-  await init();
+  const wasmModule = await compileModule();
+  await init({ module_or_path: wasmModule });
   familyTable = families();
   $('preset').append(...PRESETS.map((p) => el('option', { value: p.id }, p.title)));
   $('preset').addEventListener('change', () => {
@@ -515,7 +532,7 @@ async function main() {
   window.addEventListener('resize', () => { clearTimeout(resizeTimer); resizeTimer = setTimeout(update, 100); });
   fromLocation({ startup: true });
   // Measured data: identified modes replace the editor's modes with one click.
-  setupMeasure({ acceptModes(modes) { state.modes = modes.slice(0, MAX_MODES); rebuild(); changed(true); } });
+  setupMeasure({ wasmModule, acceptModes(modes) { state.modes = modes.slice(0, MAX_MODES); rebuild(); changed(true); } });
   // For the benchmark script: a full update, timed.
   window.__playground = { update, get state() { return state; } };
 }

@@ -1,10 +1,10 @@
 // Measured data (issue 7): load a recording, show its spectrum with the detected peaks, the
 // identified modes with their uncertainties, and the ranked shaper recommendation. The reading
-// (in 1 MB chunks, with progress) and the identification run in a worker (web/measure_worker.js),
-// so a 10⁶-row file never freezes the page; a bad file leaves the last good result on screen.
-// The worker and its module are fetched when the first file is opened, not with the page. The
-// ranking designs every candidate shaper, which the page's own module already can: it runs here.
-import { drawSpectrum, recommendShaper } from '../pkg/page/playground.js';
+// (in 1 MB chunks, with progress), the identification and the ranking run in a worker
+// (web/measure_worker.js), so a 10⁶-row file never freezes the page; a bad file leaves the last
+// good result on screen. The worker and its own module are fetched when the first file is
+// opened, not with the page; for the ranking it is handed the page's compiled module.
+import { drawSpectrum } from '../pkg/page/playground.js';
 
 const $ = (id) => document.getElementById(id);
 /** Largest file accepted (a 10⁷-row Klipper file is ~350 MB). */
@@ -16,6 +16,7 @@ let fft = null; // the FFT magnitude of the current channel, when shown
 let request = 0; // id of the latest request: older answers are ignored
 let fileName = '';
 let acceptModes = () => {};
+let wasmModule = null; // the page's compiled module, for the worker's ranking
 
 function el(tag, props = {}, ...children) {
   const node = document.createElement(tag);
@@ -81,20 +82,10 @@ function onMessage({ data }) {
   } else if (data.type === 'result') {
     progress.hidden = true;
     fft = null;
-    show({ ...data, recommendation: rank(data.identification) });
+    if (data.rankingError) showError(`Could not rank the shapers for these modes: ${data.rankingError}`);
+    show(data);
     if ($('measure-view').value === 'fft') requestFft();
     $('measure-file-name').textContent = fileName;
-  }
-}
-
-/** The ranked shapers for the identified modes, or null (no mode, or none could be designed). */
-function rank(id) {
-  if (id.modes.length === 0) return null;
-  try {
-    return recommendShaper(id.spectrum, id.modes, {});
-  } catch (e) {
-    showError(`Could not rank the shapers for these modes: ${e?.message ?? e}`);
-    return null;
   }
 }
 
@@ -103,6 +94,7 @@ function startWorker() {
   worker = new Worker(new URL('./measure_worker.js', import.meta.url), { type: 'module' });
   worker.addEventListener('message', onMessage);
   worker.addEventListener('error', (e) => showError(`The measurement worker failed: ${e.message ?? e}`));
+  worker.postMessage({ type: 'module', module: wasmModule });
 }
 
 function requestFft() {
@@ -180,9 +172,13 @@ function draw() {
   }
 }
 
-/** Wires the section; `hooks.acceptModes(modes)` puts modes into the playground's editor. */
+/**
+ * Wires the section; `hooks.acceptModes(modes)` puts modes into the playground's editor,
+ * `hooks.wasmModule` is the page's compiled module (the worker ranks shapers with it).
+ */
 export function setupMeasure(hooks) {
   acceptModes = hooks.acceptModes;
+  wasmModule = hooks.wasmModule;
   const input = $('measure-file');
   input.addEventListener('change', () => {
     const file = input.files[0];

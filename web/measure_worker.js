@@ -1,14 +1,17 @@
-// The measured-data worker: reads a recording in chunks and identifies its modes off the page's
-// thread, so a 10⁶-row file never freezes the page. Messages in: { id, type: 'load', file,
+// The measured-data worker: reads a recording in chunks, identifies the modes and ranks the
+// shapers off the page's thread, so a 10⁶-row file never freezes the page. Messages in:
+// { type: 'module', module } (first: the page's compiled wasm module), { id, type: 'load', file,
 // options }, { id, type: 'analyse', options } and { id, type: 'fft', channel }; out: progress,
-// result ({ recording, identification }), fft ({ spectrum }) or error ({ message, line,
-// column }). It loads its own small module (pkg/page/recording.js: parsing, spectra,
-// identification); the shaper ranking needs the designs, which the page's module has, so the
-// page ranks the identified modes itself (web/measure.js).
-import init, { RecordingParser, identifyModes, fftSpectrum } from '../pkg/page/recording.js';
+// result ({ recording, identification, recommendation, rankingError }), fft ({ spectrum }) or
+// error ({ message, line, column }). Reading and identifying use the worker's own small module
+// (pkg/page/recording.js); the ranking designs every candidate shaper, which only the page's
+// module can, so the page hands over that module, already compiled (nothing fetched again).
+import initRecording, { RecordingParser, identifyModes, fftSpectrum } from '../pkg/page/recording.js';
+import initPlayground, { recommendShaper } from '../pkg/page/playground.js';
 
 const CHUNK_BYTES = 1 << 20;
-const ready = init();
+const ready = initRecording();
+let designs = null; // the page's module, instantiated here
 let recording = null; // the last good recording
 
 function summary(r) {
@@ -35,13 +38,27 @@ async function read(id, file) {
 function analyse(id, rec, options) {
   postMessage({ id, type: 'analysing', rows: rec.rows });
   const identification = identifyModes(rec, options);
-  return { id, type: 'result', recording: summary(rec), identification };
+  let recommendation = null;
+  let rankingError = null;
+  if (identification.modes.length > 0) {
+    try {
+      recommendation = recommendShaper(identification.spectrum, identification.modes, {});
+    } catch (e) {
+      rankingError = e?.message ?? String(e); // the modes stay shown; only the ranking is missing
+    }
+  }
+  return { id, type: 'result', recording: summary(rec), identification, recommendation, rankingError };
 }
 
 onmessage = async ({ data }) => {
   const { id } = data;
+  if (data.type === 'module') {
+    designs = initPlayground(data.module ? { module_or_path: data.module } : undefined);
+    return;
+  }
   try {
     await ready;
+    await (designs ??= initPlayground()); // without the page's module, fetch it
     if (data.type === 'load') {
       const rec = await read(id, data.file);
       const result = analyse(id, rec, data.options);

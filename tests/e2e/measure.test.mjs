@@ -126,7 +126,8 @@ test('the measured-data worker and its module are fetched when a recording is op
   await page.waitForSelector('#measure-modes tbody tr[data-mode]', { timeout: 120000 });
   assert.ok(fetched.includes('/pkg/page/measure_worker.js') && fetched.includes('/pkg/page/recording_bg.wasm'), fetched.join(' '));
   assert.ok(!fetched.includes('/pkg/input_shaping_bg.wasm'), 'the whole-API module is never fetched by the page');
-  // The ranking runs on the page's thread, with the page's module.
+  // The worker ranks with the page's module, handed over compiled: not fetched a second time.
+  assert.ok(!fetched.includes('/pkg/page/playground_bg.wasm'), fetched.join(' '));
   assert.match(await page.textContent('#measure-recommended'), /^Recommended: /);
   assert.deepEqual(problems, []);
   await page.close();
