@@ -24,7 +24,8 @@ fi
 
 # Three modules from one crate, each with the exports of some Cargo features (Cargo.toml):
 #   pkg/input_shaping.js          the whole JavaScript API (README), for programs of your own;
-#   pkg/page/playground.js        what the page's main thread calls (js-playground);
+#   pkg/page/playground.js        what the page calls (js-playground; the measured-data
+#                                 worker ranks shapers with it too, handed over compiled);
 #   pkg/page/recording.js         what its measured-data worker calls (js-recording), fetched
 #                                 only when a recording is opened.
 # The linker keeps only the code an export reaches, so the page's modules are smaller than the

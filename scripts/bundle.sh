@@ -2,8 +2,9 @@
 # Bundles and minifies the page's scripts (esbuild) next to its wasm modules, into pkg/page/:
 #   main.js            web/main.js with web/state.js, params.js, measure.js and the
 #                      playground module's glue (index.html loads it);
-#   measure_worker.js  web/measure_worker.js with the recording module's glue (started by
-#                      main.js when the first recording is opened).
+#   measure_worker.js  web/measure_worker.js with the recording module's glue and the
+#                      playground module's (it ranks shapers with the page's module, which
+#                      main.js hands it compiled); started when the first recording is opened.
 # Each glue finds its .wasm next to the bundle (new URL(…, import.meta.url)), so the bundles
 # live in pkg/page/ with them. Source maps point back to web/. Run by scripts/build.sh after
 # the wasm modules; alone (`npm run build:web`) after editing web/.
