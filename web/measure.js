@@ -94,7 +94,11 @@ function startWorker() {
   worker = new Worker(new URL('./measure_worker.js', import.meta.url), { type: 'module' });
   worker.addEventListener('message', onMessage);
   worker.addEventListener('error', (e) => showError(`The measurement worker failed: ${e.message ?? e}`));
-  worker.postMessage({ type: 'module', module: wasmModule });
+  try {
+    worker.postMessage({ type: 'module', module: wasmModule });
+  } catch {
+    worker.postMessage({ type: 'module', module: null }); // not cloneable here: the worker fetches it
+  }
 }
 
 function requestFft() {
