@@ -42,6 +42,17 @@ pub enum Error {
         /// The backend's message.
         reason: String,
     },
+    /// The request needs a part of the library this build leaves out: the optimisation solver
+    /// of the solved families (`si`, `direct`, and `sampled` when an amplitude or increment
+    /// bound is active), Cargo feature `solver`. Only builds without that feature return it:
+    /// the page's first wasm module, which fetches the module with the solver when it sees
+    /// this error (README, *Shipped size*).
+    Unavailable {
+        /// The field whose value needs the left-out part (`shapers[0]`, say).
+        field: String,
+        /// What is left out and why it is needed.
+        reason: String,
+    },
 }
 
 impl Error {
@@ -53,12 +64,24 @@ impl Error {
         }
     }
 
+    /// The [`Error::Unavailable`] of a solved family's design in a build without the solver.
+    #[cfg_attr(feature = "solver", allow(dead_code))]
+    pub(crate) fn solver_left_out() -> Self {
+        Error::Unavailable {
+            field: String::new(),
+            reason: "this shaper is designed by the optimisation solver, which this build of \
+                     the library leaves out (Cargo feature `solver`)"
+                .into(),
+        }
+    }
+
     /// The field this error concerns, if any.
     pub fn field(&self) -> Option<&str> {
         match self {
             Error::InvalidInput { field, .. }
             | Error::TooLarge { field, .. }
-            | Error::Parse { field, .. } => Some(field.as_str()).filter(|f| !f.is_empty()),
+            | Error::Parse { field, .. }
+            | Error::Unavailable { field, .. } => Some(field.as_str()).filter(|f| !f.is_empty()),
             Error::Infeasible { .. } | Error::Render { .. } => None,
         }
     }
@@ -92,6 +115,10 @@ impl Error {
                 field: join(field),
                 reason,
             },
+            Error::Unavailable { field, reason } => Error::Unavailable {
+                field: join(field),
+                reason,
+            },
             e @ (Error::Infeasible { .. } | Error::Render { .. }) => e,
         }
     }
@@ -111,8 +138,13 @@ impl fmt::Display for Error {
             ),
             Error::Infeasible { reason } => write!(f, "infeasible: {reason}"),
             Error::Render { reason } => write!(f, "chart could not be drawn: {reason}"),
-            Error::Parse { field, reason } if field.is_empty() => write!(f, "{reason}"),
-            Error::Parse { field, reason } => write!(f, "{field}: {reason}"),
+            Error::Parse { field, reason } | Error::Unavailable { field, reason } => {
+                if field.is_empty() {
+                    write!(f, "{reason}")
+                } else {
+                    write!(f, "{field}: {reason}")
+                }
+            }
         }
     }
 }

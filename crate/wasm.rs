@@ -43,6 +43,7 @@ pub(crate) fn js_error(error: Error) -> JsValue {
         Error::Infeasible { .. } => "infeasible",
         Error::Parse { .. } => "parse",
         Error::Render { .. } => "render",
+        Error::Unavailable { .. } => "unavailable",
     };
     let _ = js_sys::Reflect::set(&e, &"kind".into(), &kind.into());
     if let Some(field) = error.field() {
@@ -559,9 +560,13 @@ fn robustness_rows(mode: &Mode, vtol: f64) -> Result<Vec<RobustnessRow>, Error> 
         None => {
             let unit = Mode::new(1.0, mode.damping())?;
             // Families that cannot be designed for this mode (e.g. EI beyond its damping
-            // range) are left out of the background rather than failing the frame.
+            // range) are left out of the background rather than failing the frame. So is
+            // `direct`: for one mode it is the ZVD shaper itself (tests/direct.rs,
+            // one_mode_reproduces_zv_and_zvd_closed_forms), a second point on ZVD's, and its
+            // design needs the solver, which the page's first module leaves out.
             let rows: Vec<RobustnessRow> = crate::robustness::parameterless_specs()
                 .into_iter()
+                .filter(|spec| !matches!(spec, ShaperSpec::Direct(_)))
                 .filter_map(|spec| {
                     crate::robustness::robustness_table(std::slice::from_ref(&spec), &unit, vtol)
                         .ok()

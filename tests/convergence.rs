@@ -77,10 +77,15 @@ impl Grid {
                     Error::TooLarge { .. } => "tooLarge",
                     Error::Parse { .. } => "parse",
                     Error::Render { .. } => "render",
+                    Error::Unavailable { .. } => "unavailable",
                 };
                 let text = e.to_string();
                 // A parse or render error, or one without a reason, explains nothing.
-                if matches!(e, Error::Parse { .. } | Error::Render { .. }) || text.len() < 20 {
+                if matches!(
+                    e,
+                    Error::Parse { .. } | Error::Render { .. } | Error::Unavailable { .. }
+                ) || text.len() < 20
+                {
                     tally.wrong.push(format!("{what}: unexplained error {e:?}"));
                     return;
                 }

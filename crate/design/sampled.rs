@@ -564,6 +564,7 @@ impl Problem {
 /// Bounds of eq. 7 may be exceeded by at most this much (rounding of the final solve).
 const BOUND_TOLERANCE: f64 = 1e-9;
 /// Most working-set changes of the active-set loop.
+#[cfg(feature = "solver")]
 const MAX_ACTIVE_SET_STEPS: usize = 60;
 
 fn max_violation(g: &DMatrix<f64>, h: &DVector<f64>, x: &DVector<f64>) -> f64 {
@@ -619,9 +620,23 @@ fn equality_qp(
     Some((z.rows(0, n).into_owned(), z.rows(n, r).into_owned()))
 }
 
+/// Without the solver (Cargo feature `solver`): active bounds need the QP below.
+#[cfg(not(feature = "solver"))]
+fn bounded_qp(
+    _: &DMatrix<f64>,
+    _: &DVector<f64>,
+    _: &DMatrix<f64>,
+    _: &DVector<f64>,
+    _: &DMatrix<f64>,
+    _: &DVector<f64>,
+) -> Result<DVector<f64>> {
+    Err(Error::solver_left_out())
+}
+
 /// The QP with the bounds: clarabel finds the optimum and which bounds are active; the
 /// active-set loop then solves the KKT system with those bounds as equalities, so the result
 /// satisfies eq. 13 to rounding.
+#[cfg(feature = "solver")]
 fn bounded_qp(
     h: &DMatrix<f64>,
     f: &DVector<f64>,
@@ -740,6 +755,7 @@ fn bounded_qp(
 }
 
 /// A column-compressed matrix from a dense generator, skipping zeros.
+#[cfg(feature = "solver")]
 fn csc(
     rows: usize,
     cols: usize,

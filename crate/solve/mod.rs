@@ -25,6 +25,10 @@
 //! problem, so the numbers stay O(1) for any mode from millihertz to megahertz. Every iteration
 //! is bounded (see the constants below).
 
+// Built without the solver (Cargo feature `solver`), the driver below is cut off after the
+// problem's checks: the programs, the polish and the scans are then unused.
+#![cfg_attr(not(feature = "solver"), allow(dead_code, unused_imports))]
+
 pub(crate) mod grid;
 pub(crate) mod polish;
 pub(crate) mod scan;
@@ -448,8 +452,23 @@ impl NormalizedProblem {
 ///
 /// Errors: [`Error::InvalidInput`] for out-of-range data, [`Error::Infeasible`] when no shaper
 /// within the duration limit meets the constraints (with the reason).
+///
+/// In a build without the Cargo feature `solver` (the page's first wasm module) the problem is
+/// still checked, but a valid one is answered with [`Error::Unavailable`].
 pub fn minimum_duration(problem: &Problem) -> Result<Design> {
     let norm = NormalizedProblem::new(problem)?;
+    shortest(norm)
+}
+
+/// Without the solver: nothing below is compiled into the wasm.
+#[cfg(not(feature = "solver"))]
+fn shortest(_: NormalizedProblem) -> Result<Design> {
+    Err(Error::solver_left_out())
+}
+
+/// [`minimum_duration`] on the normalised problem.
+#[cfg(feature = "solver")]
+fn shortest(norm: NormalizedProblem) -> Result<Design> {
     let mut samples: Vec<NormalizedLimit> = norm.limits.clone();
     for band in &norm.bands {
         samples.extend(scan::initial_samples(band));

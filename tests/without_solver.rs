@@ -1,0 +1,138 @@
+//! A build without the Cargo feature `solver`, as the page's first wasm module is built
+//! (scripts/build.sh): the solved families answer [`Error::Unavailable`] (the page then fetches
+//! the module with the solver), every other family designs as before, and bad input to a solved
+//! family is still reported at its field, so the page shows it without fetching anything.
+//!
+//! Only compiled without the feature: scripts/test.sh runs
+//! `cargo test --no-default-features --test without_solver`.
+#![cfg(not(feature = "solver"))]
+
+mod common;
+
+use common::close;
+use input_shaping::design::design_for;
+use input_shaping::design::sampled::SampledSpec;
+use input_shaping::vibration::residual_vibration;
+use input_shaping::{Error, Mode, ShaperSpec};
+
+fn spec(json: &str) -> ShaperSpec {
+    serde_json::from_str(json).unwrap()
+}
+
+fn unavailable(spec: &ShaperSpec, modes: &[Mode]) -> Error {
+    let e = design_for(spec, modes).expect_err("designed without the solver");
+    assert!(
+        matches!(e, Error::Unavailable { .. }),
+        "{spec:?}: {e:?} is not Unavailable"
+    );
+    e
+}
+
+/// Kamel, Lange & Hirzinger §6 (ω = 30 rad/s, D = 0.02, T = 12 ms, n = 36, m = 17, K = 8·10⁻⁴).
+fn kamel_mode() -> Mode {
+    Mode::new(30.0 / (2.0 * std::f64::consts::PI), 0.02).unwrap()
+}
+
+fn kamel_spec() -> SampledSpec {
+    SampledSpec {
+        delay_samples: Some(17),
+        plant_gain: Some(8e-4),
+        ..SampledSpec::new(0.012, 36)
+    }
+}
+
+#[test]
+fn solved_families_are_unavailable_with_a_message() {
+    let mode = Mode::new(0.5, 0.002).unwrap();
+    for json in [
+        // Peláez & Singhose 2002: SI with I = 0.7 at Vtol 5 %.
+        r#"{"family":"si","vtol":0.05,"insensitivity":0.7}"#,
+        r#"{"family":"direct"}"#,
+        r#"{"family":"direct","derivatives":0}"#,
+    ] {
+        let e = unavailable(&spec(json), &[mode]);
+        let text = e.within("shapers[1]").to_string();
+        assert!(
+            text.starts_with("shapers[1]: this shaper is designed by the optimisation solver"),
+            "{text}"
+        );
+        assert!(text.contains("`solver`"), "{text}");
+    }
+    // Kamel et al. eq. 7 bounds that the unbounded optimum breaks (0 ≤ Aᵢ ≤ 0.1,
+    // |ΔAᵢ| ≤ 0.02; tests/sampled.rs, bounds_are_met_exactly_at_the_optimum) need the QP.
+    let bounded = ShaperSpec::Sampled(SampledSpec {
+        amplitude_min: Some(0.0),
+        amplitude_max: Some(0.1),
+        increment_min: Some(-0.02),
+        increment_max: Some(0.02),
+        ..kamel_spec()
+    });
+    let e = unavailable(&bounded, &[kamel_mode()]);
+    assert_eq!(e.within("shapers[0]").field(), Some("shapers[0]"));
+}
+
+/// Without active bounds the sampled family is closed form (eq. 25): designed as before, and
+/// its shaper meets eq. 13 (zero residual vibration at the mode). Bounds the unbounded optimum
+/// already meets do not need the QP either.
+#[test]
+fn sampled_without_active_bounds_is_designed() {
+    let mode = kamel_mode();
+    for spec in [
+        kamel_spec(),
+        SampledSpec {
+            amplitude_min: Some(-10.0),
+            amplitude_max: Some(10.0),
+            ..kamel_spec()
+        },
+    ] {
+        let shaper = design_for(&ShaperSpec::Sampled(spec), &[mode]).unwrap();
+        assert_eq!(shaper.len(), 36);
+        assert!(residual_vibration(&shaper, &mode) < 1e-9);
+    }
+}
+
+/// Singer & Seering 1988: ZVD = [1/4, 1/2, 1/4] at 0, T/2, T for an undamped mode; and the
+/// EI and negative families, which need no solver, still design.
+#[test]
+fn other_families_are_designed() {
+    let mode = Mode::new(2.0, 0.0).unwrap();
+    let zvd = design_for(&spec(r#"{"family":"zvd"}"#), &[mode]).unwrap();
+    let want = [(0.0, 0.25), (0.25, 0.5), (0.5, 0.25)];
+    assert_eq!(zvd.len(), 3);
+    for (imp, (t, a)) in zvd.impulses().iter().zip(want) {
+        close(imp.time, t, 1e-12, "ZVD time");
+        close(imp.amplitude, a, 1e-12, "ZVD amplitude");
+    }
+    for json in [
+        r#"{"family":"ei","vtol":0.05}"#,
+        r#"{"family":"eihump","humps":4,"vtol":0.05}"#,
+        r#"{"family":"umzvd"}"#,
+        r#"{"family":"mzv"}"#,
+    ] {
+        let s = design_for(&spec(json), &[mode]).unwrap();
+        assert!(residual_vibration(&s, &mode) < 0.05 + 1e-9, "{json}");
+    }
+}
+
+/// A bad field of a solved family is reported at the field, not as Unavailable: the page shows
+/// it next to the field and does not fetch the solver for a request that would fail anyway.
+#[test]
+fn bad_input_to_solved_families_is_reported_at_its_field() {
+    let mode = Mode::new(1.0, 0.01).unwrap();
+    for (json, field) in [
+        (r#"{"family":"si","vtol":1.5,"insensitivity":0.3}"#, "vtol"),
+        (
+            r#"{"family":"si","vtol":0.05,"insensitivity":-1}"#,
+            "insensitivity",
+        ),
+        (r#"{"family":"direct","derivatives":9}"#, "derivatives"),
+        (
+            r#"{"family":"direct","amplitudeMin":0.5,"amplitudeMax":0.2}"#,
+            "amplitudeMin",
+        ),
+    ] {
+        let e = design_for(&spec(json), &[mode]).expect_err(json);
+        assert!(!matches!(e, Error::Unavailable { .. }), "{json}: {e:?}");
+        assert_eq!(e.field(), Some(field), "{json}: {e}");
+    }
+}
