@@ -2,7 +2,7 @@
 // frame (renderPlayground), and the numbers, charts and exports of the last good result. A bad
 // value shows its message next to its field (matched by the error's `field` against the
 // inputs' data-field) while the last good charts and numbers stay.
-import init, { renderPlayground, families, exportShaper } from '../pkg/page/playground.js';
+import * as lite from '../pkg/page/playground.js';
 import { DEFAULT_STATE, PRESETS, MAX_MODES, MAX_SHAPERS, checkState, clone, toHash, fromHash } from './state.js';
 import { COMMAND_PARAMS, commandFor } from './params.js';
 import { paramInfo, parseParam, formatParam } from './params.js';
@@ -10,6 +10,16 @@ import { setupMeasure } from './measure.js';
 
 const $ = (id) => document.getElementById(id);
 const COLORS = ['#0072b2', '#d55e00', '#009e73', '#cc79a7'];
+
+// The wasm module in use (its glue's exports: renderPlayground, families, exportShaper,
+// drawSpectrum). The page starts with `lite`, which leaves out the optimisation solver (89 KB
+// gzip); a state with a solved family (si, direct, sampled with an active bound) gets the
+// error kind "unavailable" from it, and the page switches to the module with the solver,
+// fetched then (loadSolver). A state in the URL that names si or direct starts with it.
+let api = lite;
+let solverLoad = null; // the promise of the module with the solver, once asked for
+/** The families always designed by the solver (sampled only with bounds: the error tells). */
+const SOLVED_FAMILIES = new Set(['si', 'direct']);
 
 let state = clone(DEFAULT_STATE);
 let familyTable = [];
@@ -329,7 +339,7 @@ function showExport() {
   const format = $('export-format').value;
   $('fixed-options').hidden = format !== 'cFixed';
   try {
-    $('export-output').value = exportShaper(r.shaper, {
+    $('export-output').value = api.exportShaper(r.shaper, {
       format,
       name: 'shaper',
       comment: `input-shaping: ${r.label} for ${m}`,
@@ -387,12 +397,13 @@ function update() {
   Object.values(canvases).forEach(sizeCanvas);
   const st = { ...state, view: { ...state.view, pixelRatio: window.devicePixelRatio || 1 } };
   try {
-    const result = renderPlayground(st, canvases);
+    const result = api.renderPlayground(st, canvases);
     lastGood = { state: clone(state), result };
     showResults(result, state);
     document.body.dataset.ready = 'true';
   } catch (error) {
-    showError(error);
+    if (error?.kind === 'unavailable' && api === lite) awaitSolver(error);
+    else showError(error);
   }
   return performance.now() - t0;
 }
@@ -441,12 +452,36 @@ function fromLocation({ startup = false } = {}) {
 }
 
 /**
- * The page's wasm module, compiled once: instantiated here and handed to the measured-data
- * worker, which ranks shapers with it without fetching or compiling it again. This file runs as
- * the bundle pkg/page/main.js (scripts/bundle.sh), beside the .wasm, as the glue inside it does.
+ * The state needs the solver: keeps the last good charts, says so at the shaper, fetches the
+ * module with the solver once and redraws with it (or says why it could not be fetched).
  */
-async function compileModule() {
-  const response = await fetch(new URL('playground_bg.wasm', import.meta.url));
+function awaitSolver(error) {
+  showError({ field: error.field, message: 'Fetching the optimisation solver this shaper is designed with…' });
+  document.body.dataset.fetching = 'solver'; // for the tests: wait until it is gone
+  loadSolver().then(schedule, (e) => {
+    solverLoad = null; // the next edit tries again
+    showError({ field: error.field, message: `The optimisation solver could not be loaded (${e?.message ?? e}): ${error.message}` });
+  }).finally(() => delete document.body.dataset.fetching);
+}
+
+/** Fetches, compiles and instantiates the module with the solver, once; then uses it. */
+function loadSolver() {
+  solverLoad ??= (async () => {
+    const glue = await import('../pkg/page/playground_solver.js');
+    await glue.default({ module_or_path: await compileModule('playground_solver_bg.wasm') });
+    api = glue;
+  })();
+  return solverLoad;
+}
+
+/**
+ * A wasm module of the page, compiled. The first one is instantiated here and (without the
+ * solver) handed to the measured-data worker, which ranks shapers with it without fetching or
+ * compiling it again. This file runs as the bundle pkg/page/main.js (scripts/bundle.sh),
+ * beside the .wasm files, as the glue inside it does.
+ */
+async function compileModule(file) {
+  const response = await fetch(new URL(file, import.meta.url));
   if (!response.ok) throw new Error(`could not load the wasm module (HTTP ${response.status})`);
   try {
     return await WebAssembly.compileStreaming(response.clone());
@@ -457,9 +492,19 @@ async function compileModule() {
 }
 
 async function main() {
-  const wasmModule = await compileModule();
-  await init({ module_or_path: wasmModule });
-  familyTable = families();
+  // A link to a state with a solved family starts with the solver's module (one module fetched,
+  // not both); otherwise the smaller one, which the measured-data worker also uses.
+  // If that module cannot be fetched, the page starts without it and says so at the shaper.
+  const linked = fromHash(location.hash).state;
+  let wasmModule = null;
+  if (linked?.shapers.some((s) => SOLVED_FAMILIES.has(s.family))) {
+    await loadSolver().catch(() => { solverLoad = null; });
+  }
+  if (api === lite) {
+    wasmModule = await compileModule('playground_bg.wasm');
+    await lite.default({ module_or_path: wasmModule });
+  }
+  familyTable = api.families();
   $('preset').append(...PRESETS.map((p) => el('option', { value: p.id }, p.title)));
   $('preset').addEventListener('change', () => {
     const p = PRESETS.find((x) => x.id === $('preset').value);
@@ -532,7 +577,11 @@ async function main() {
   window.addEventListener('resize', () => { clearTimeout(resizeTimer); resizeTimer = setTimeout(update, 100); });
   fromLocation({ startup: true });
   // Measured data: identified modes replace the editor's modes with one click.
-  setupMeasure({ wasmModule, acceptModes(modes) { state.modes = modes.slice(0, MAX_MODES); rebuild(); changed(true); } });
+  setupMeasure({
+    wasmModule, // null when the page started with the solver's module: the worker fetches its own
+    drawSpectrum: (...args) => api.drawSpectrum(...args),
+    acceptModes(modes) { state.modes = modes.slice(0, MAX_MODES); rebuild(); changed(true); },
+  });
   // For the benchmark script: a full update, timed.
   window.__playground = { update, get state() { return state; } };
 }

@@ -4,7 +4,6 @@
 // (web/measure_worker.js), so a 10⁶-row file never freezes the page; a bad file leaves the last
 // good result on screen. The worker and its own module are fetched when the first file is
 // opened, not with the page; for the ranking it is handed the page's compiled module.
-import { drawSpectrum } from '../pkg/page/playground.js';
 
 const $ = (id) => document.getElementById(id);
 /** Largest file accepted (a 10⁷-row Klipper file is ~350 MB). */
@@ -17,6 +16,7 @@ let request = 0; // id of the latest request: older answers are ignored
 let fileName = '';
 let acceptModes = () => {};
 let wasmModule = null; // the page's compiled module, for the worker's ranking
+let drawSpectrum = null; // the page's module's drawSpectrum
 
 function el(tag, props = {}, ...children) {
   const node = document.createElement(tag);
@@ -178,11 +178,14 @@ function draw() {
 
 /**
  * Wires the section; `hooks.acceptModes(modes)` puts modes into the playground's editor,
- * `hooks.wasmModule` is the page's compiled module (the worker ranks shapers with it).
+ * `hooks.wasmModule` is the page's compiled module without the solver (the worker ranks
+ * shapers with it; null: the worker fetches it), `hooks.drawSpectrum` draws with the page's
+ * module in use.
  */
 export function setupMeasure(hooks) {
   acceptModes = hooks.acceptModes;
   wasmModule = hooks.wasmModule;
+  drawSpectrum = hooks.drawSpectrum;
   const input = $('measure-file');
   input.addEventListener('change', () => {
     const file = input.files[0];

@@ -22,15 +22,20 @@ export async function openBrowser() {
   });
   return {
     url,
-    /** A fresh page at the playground, with console errors and page errors collected. */
-    async page({ width = 1280, height = 800 } = {}) {
+    /**
+     * A fresh page at the playground (with `hash`, if given), with console errors and page
+     * errors collected in `problems` and the URL path of every request in `fetched`.
+     */
+    async page({ width = 1280, height = 800, hash = '' } = {}) {
       const page = await browser.newPage({ viewport: { width, height } });
       const problems = [];
+      const fetched = [];
       page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
       page.on('pageerror', (e) => problems.push(`pageerror: ${e.message}`));
-      await page.goto(url);
+      page.on('request', (r) => fetched.push(new URL(r.url()).pathname));
+      await page.goto(url + hash);
       await page.waitForSelector('body[data-ready="true"]', { timeout: 20000 });
-      return { page, problems };
+      return { page, problems, fetched };
     },
     async close() {
       await browser.close();
@@ -52,6 +57,18 @@ export async function canvasInfo(page, id) {
     }
     return { ink, hash, width: c.width, height: c.height };
   }, id);
+}
+
+/**
+ * Waits until the page has drawn what it was asked to: two animation frames (an edit's update
+ * runs in the next one), and, if that update had to fetch the module with the solver, until it
+ * arrived and drew.
+ */
+export async function settle(page) {
+  const frames = () => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  await frames();
+  await page.waitForSelector('body:not([data-fetching])', { timeout: 20000 });
+  await frames();
 }
 
 /** Sets an input's value as a user typing would (fires `input`). */

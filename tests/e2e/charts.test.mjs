@@ -5,7 +5,7 @@
 // the error paths, every preset, and screenshots.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { openBrowser, canvasInfo, type, SCREENSHOTS } from './browser.mjs';
+import { openBrowser, canvasInfo, type, settle, SCREENSHOTS } from './browser.mjs';
 
 const CANVASES = ['impulses-chart', 'sensitivity-chart', 'damping-chart', 'map-chart', 'response-chart',
   'command-chart', 'spectrum-chart', 'robustness-chart'];
@@ -14,7 +14,6 @@ let env;
 before(async () => { env = await openBrowser(); });
 after(async () => { await env?.close(); });
 
-const settle = (page) => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
 
 async function hashes(page) {
   const out = {};

@@ -3,7 +3,7 @@
 // state, exports, no console errors, and screenshots.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { openBrowser, canvasInfo, type, SCREENSHOTS } from './browser.mjs';
+import { openBrowser, canvasInfo, type, settle, SCREENSHOTS } from './browser.mjs';
 
 let env;
 before(async () => { env = await openBrowser(); });
@@ -26,7 +26,6 @@ async function summary(page) {
   return page.$$eval('#summary tbody tr', (rows) => Object.fromEntries(rows.map((r) => [r.cells[0].textContent, [...r.cells].slice(1).map((c) => c.textContent)])));
 }
 
-const settle = (page) => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
 
 test('the default page shows the ZVD shaper of the closed form and draws both charts', async () => {
   const { page, problems } = await env.page();
@@ -137,6 +136,85 @@ test('every preset loads and draws', async () => {
     await page.screenshot({ path: `${SCREENSHOTS}preset-${id}.png`, fullPage: true });
   }
   assert.deepEqual(problems, []);
+  await page.close();
+});
+
+/** Peláez & Singhose 2002's carrousel (0.5 Hz, ζ 0.002) and an SI shaper at Vtol 5 % sampled at
+ * six frequencies over I = 0.7 ([0.325, 0.675] Hz), with ZVD beside it. */
+const SI_STATE = {
+  modes: [{ frequencyHz: 0.5, damping: 0.002 }],
+  shapers: [{ family: 'si', vtol: 0.05, insensitivity: 0.7, sampleFrequenciesHz: [0.325, 0.395, 0.465, 0.535, 0.605, 0.675] }, { family: 'zvd' }],
+};
+/** The same problem solved by scipy SLSQP from random starts (benches/si_slsqp.py), an
+ * independent design: t and A of its four impulses. */
+const SI_SLSQP = [[0, 0.16417], [0.96332, 0.3381], [1.93253, 0.33631], [2.89507, 0.16142]];
+
+function assertSlsqp(rows) {
+  assert.equal(rows.length, 4, JSON.stringify(rows));
+  rows.forEach(([t, a], i) => {
+    assert.ok(Math.abs(t - SI_SLSQP[i][0]) < 2e-5, `time ${i}: ${t} vs ${SI_SLSQP[i][0]}`);
+    assert.ok(Math.abs(a - SI_SLSQP[i][1]) < 2e-5, `amplitude ${i}: ${a} vs ${SI_SLSQP[i][1]}`);
+  });
+}
+
+test('a solved family fetches the module with the solver, once, and designs what the core designs', async () => {
+  const { page, problems, fetched } = await env.page();
+  // The default page (ZVD) loads the module without the solver only.
+  assert.ok(fetched.includes('/pkg/page/playground_bg.wasm'), fetched.join(' '));
+  assert.ok(!fetched.some((f) => f.startsWith('/pkg/page/playground_solver')), fetched.join(' '));
+  const before = await canvasInfo(page, 'impulses-chart');
+  await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, SI_STATE);
+  await settle(page);
+  assert.equal(fetched.filter((f) => f === '/pkg/page/playground_solver_bg.wasm').length, 1, fetched.join(' '));
+  assertSlsqp(await impulseRows(page, 0));
+  assert.equal((await impulseRows(page, 1)).length, 3);
+  const errors = await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
+  assert.deepEqual(errors, []);
+  const after = await canvasInfo(page, 'impulses-chart');
+  assert.ok(after.ink > 1000 && after.hash !== before.hash, 'the SI shaper is drawn');
+  // Later edits use the module already there: nothing is fetched again.
+  const count = fetched.length;
+  await type(page, 'mode-0-damping', 0.004);
+  await settle(page);
+  assert.deepEqual(fetched.slice(count), []);
+  assert.equal((await impulseRows(page, 0)).length, 4);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('a link with a solved family starts with the module with the solver, not both', async () => {
+  const { page, problems, fetched } = await env.page({ hash: `#state=${encodeURIComponent(JSON.stringify(SI_STATE))}` });
+  assert.ok(fetched.includes('/pkg/page/playground_solver_bg.wasm'), fetched.join(' '));
+  assert.ok(!fetched.includes('/pkg/page/playground_bg.wasm'), fetched.join(' '));
+  assertSlsqp(await impulseRows(page, 0));
+  await page.screenshot({ path: `${SCREENSHOTS}si-link-1280x800.png`, fullPage: true });
+  // Back to a state without a solved family: the module with the solver goes on serving it.
+  await page.evaluate(() => { location.hash = `#state=${encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: 2, damping: 0.05 }], shapers: [{ family: 'zvd' }] }))}`; });
+  await settle(page);
+  assert.equal((await impulseRows(page, 0)).length, 3);
+  assert.ok(!fetched.includes('/pkg/page/playground_bg.wasm'), fetched.join(' '));
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('if the solver\'s module cannot be fetched, the shaper says so, the last good result stays, and the next edit tries again', async () => {
+  const { page, problems } = await env.page();
+  const before = { imp: await canvasInfo(page, 'impulses-chart'), rows: await impulseRows(page) };
+  await page.route('**/playground_solver*', (r) => r.abort());
+  await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, SI_STATE);
+  await settle(page);
+  const message = await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
+  assert.equal(message.length, 1, JSON.stringify(message));
+  assert.match(message[0], /^The optimisation solver could not be loaded \(.*\): shapers\[0\]: this shaper is designed by the optimisation solver/);
+  assert.equal((await canvasInfo(page, 'impulses-chart')).hash, before.imp.hash, 'the last good chart stays');
+  assert.deepEqual(await impulseRows(page), before.rows, 'the last good numbers stay');
+  await page.unroute('**/playground_solver*');
+  await type(page, 'mode-0-damping', 0.003);
+  await settle(page);
+  assert.deepEqual(await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean)), []);
+  assert.equal((await impulseRows(page, 0)).length, 4);
+  // The aborted requests are the only console errors.
+  assert.deepEqual(problems.filter((p) => !/Failed to load resource|playground_solver/.test(p)), []);
   await page.close();
 });
 
