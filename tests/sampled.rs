@@ -15,15 +15,11 @@ use wasm_bindgen_test::wasm_bindgen_test;
 /// The paper's §6 / Fig. 3 setting: ω = 30 rad/s, D = 0.02, K = 8·10⁻⁴, T = 12 ms, n = 36,
 /// m = 17, Q = 0.1·I.
 fn paper_mode() -> Mode {
-    Mode::new(30.0 / (2.0 * std::f64::consts::PI), 0.02).unwrap()
+    common::kamel_mode()
 }
 
 fn paper_spec() -> SampledSpec {
-    SampledSpec {
-        delay_samples: Some(17),
-        plant_gain: Some(8e-4),
-        ..SampledSpec::new(0.012, 36)
-    }
+    common::kamel_spec()
 }
 
 /// ∫ e² over [0, until] by Simpson's rule on each period (e jumps only at multiples of T),

@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::close;
+use common::{close, kamel_mode, kamel_spec};
 use input_shaping::design::design_for;
 use input_shaping::design::sampled::SampledSpec;
 use input_shaping::vibration::residual_vibration;
@@ -26,19 +26,6 @@ fn unavailable(spec: &ShaperSpec, modes: &[Mode]) -> Error {
         "{spec:?}: {e:?} is not Unavailable"
     );
     e
-}
-
-/// Kamel, Lange & Hirzinger §6 (ω = 30 rad/s, D = 0.02, T = 12 ms, n = 36, m = 17, K = 8·10⁻⁴).
-fn kamel_mode() -> Mode {
-    Mode::new(30.0 / (2.0 * std::f64::consts::PI), 0.02).unwrap()
-}
-
-fn kamel_spec() -> SampledSpec {
-    SampledSpec {
-        delay_samples: Some(17),
-        plant_gain: Some(8e-4),
-        ..SampledSpec::new(0.012, 36)
-    }
 }
 
 #[test]

@@ -30,3 +30,17 @@ pub fn close(a: f64, b: f64, tol: f64, what: &str) {
         "{what}: got {a}, expected {b} (tolerance {tol})"
     );
 }
+
+/// Kamel, Lange & Hirzinger §6 / Fig. 3: ω = 30 rad/s, D = 0.02.
+pub fn kamel_mode() -> Mode {
+    Mode::new(30.0 / (2.0 * std::f64::consts::PI), 0.02).unwrap()
+}
+
+/// Kamel, Lange & Hirzinger §6 / Fig. 3: K = 8·10⁻⁴, T = 12 ms, n = 36, m = 17, Q = 0.1·I.
+pub fn kamel_spec() -> input_shaping::design::sampled::SampledSpec {
+    input_shaping::design::sampled::SampledSpec {
+        delay_samples: Some(17),
+        plant_gain: Some(8e-4),
+        ..input_shaping::design::sampled::SampledSpec::new(0.012, 36)
+    }
+}
