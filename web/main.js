@@ -280,7 +280,10 @@ function showResults(result, st) {
     rows.push([`Residual vibration${tag} (%)`, (r) => fmtPct(r.residualAtModes[i])]);
   });
   rows.push(['Klipper smoothing at 5000 mm/s² (mm)', (r) => (r.klipper == null ? 'n/a (Σ amplitudes = 0)' : fmt(r.klipper.smoothing, 4))]);
-  rows.push(['Klipper max accel (mm/s²)', (r) => (r.klipper == null ? 'n/a' : r.klipper.maxAccel == null ? '∞' : fmt(r.klipper.maxAccel, 5))]);
+  // Klipper's answer is 0 when even a vanishing acceleration smooths more than its 0.12 mm
+  // target (long, low-frequency shapers): said in words, not left as a bare 0.
+  const maxAccel = (a) => (a == null ? '∞' : a === 0 ? '0 (none keeps smoothing ≤ 0.12 mm)' : fmt(a, 5));
+  rows.push(['Klipper max accel, smoothing ≤ 0.12 mm (mm/s²)', (r) => (r.klipper == null ? 'n/a' : maxAccel(r.klipper.maxAccel))]);
   syncRows($('summary').tBodies[0], rows.map(([name, f]) => [name, ...results.map((r) => f(r))]));
 
   showSimulation(result);

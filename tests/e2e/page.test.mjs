@@ -187,6 +187,9 @@ test('a link with a solved family starts with the module with the solver, not bo
   assert.ok(fetched.includes('/pkg/page/playground_solver_bg.wasm'), fetched.join(' '));
   assert.ok(!fetched.includes('/pkg/page/playground_bg.wasm'), fetched.join(' '));
   assertSlsqp(await impulseRows(page, 0));
+  // A 0.5 Hz shaper smooths more than Klipper's 0.12 mm target at any acceleration: Klipper's
+  // max accel is 0, said in words.
+  assert.deepEqual((await summary(page))['Klipper max accel, smoothing ≤ 0.12 mm (mm/s²)'], ['0 (none keeps smoothing ≤ 0.12 mm)', '0 (none keeps smoothing ≤ 0.12 mm)']);
   await page.screenshot({ path: `${SCREENSHOTS}si-link-1280x800.png`, fullPage: true });
   // Back to a state without a solved family: the module with the solver goes on serving it.
   await page.evaluate(() => { location.hash = `#state=${encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: 2, damping: 0.05 }], shapers: [{ family: 'zvd' }] }))}`; });
