@@ -12,6 +12,7 @@ mod common;
 use common::{close, kamel_mode, kamel_spec};
 use input_shaping::design::design_for;
 use input_shaping::design::sampled::SampledSpec;
+use input_shaping::robustness::parameterless_specs;
 use input_shaping::vibration::residual_vibration;
 use input_shaping::{Error, Mode, ShaperSpec};
 
@@ -98,6 +99,26 @@ fn other_families_are_designed() {
     ] {
         let s = design_for(&spec(json), &[mode]).unwrap();
         assert!(residual_vibration(&s, &mode) < 0.05 + 1e-9, "{json}");
+    }
+}
+
+/// The page's robustness background (every parameterless family but `direct`) is the same
+/// without the solver: each of those families designs, for damped and undamped modes, and
+/// `direct` is the only one that needs the solver.
+#[test]
+fn robustness_background_needs_no_solver() {
+    for mode in [Mode::new(1.0, 0.0).unwrap(), Mode::new(1.0, 0.05).unwrap()] {
+        for spec in parameterless_specs() {
+            let designed = design_for(&spec, &[mode]);
+            if matches!(spec, ShaperSpec::Direct(_)) {
+                assert!(
+                    matches!(designed, Err(Error::Unavailable { .. })),
+                    "{designed:?}"
+                );
+            } else {
+                assert!(designed.is_ok(), "{spec:?}: {designed:?}");
+            }
+        }
     }
 }
 
