@@ -48,7 +48,7 @@ layer() {
 layer fmt cargo fmt --check
 layer clippy cargo clippy --all-targets -- -D warnings
 layer clippy-wasm cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
-# The page's two modules are built from subsets of the JS API's features (scripts/build.sh).
+# The page's modules are built from subsets of the features (scripts/build.sh).
 layer clippy-page-modules bash -c 'for f in js-playground js-playground,solver js-recording; do cargo clippy --target wasm32-unknown-unknown --lib --no-default-features --features "$f" -- -D warnings || exit 1; done'
 # The public API's rustdoc builds without warnings (broken or private intra-doc links).
 layer doc env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib
@@ -56,9 +56,9 @@ layer doc-wasm env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib --target
 # Includes the reliability layer's property tests and fuzz replay (issue 6). Every loop in the
 # library is bounded; the timeout turns a hang into a failure instead of a stalled CI.
 layer native timeout 2400 cargo test -- --skip quick_grid
-# The quick convergence grid on its own, so its counts (ok / infeasible / wrong) are in the log.
 # The build without the solver (the page's first module): solved families answer Unavailable.
 layer native-without-solver cargo test --no-default-features --test without_solver
+# The quick convergence grid on its own, so its counts (ok / infeasible / wrong) are in the log.
 layer convergence timeout 1500 cargo test --test convergence -- --nocapture
 layer wasm-node wasm-pack test --node
 layer wasm-browser wasm-pack test --headless --chrome
