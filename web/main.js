@@ -12,7 +12,7 @@ const $ = (id) => document.getElementById(id);
 const COLORS = ['#0072b2', '#d55e00', '#009e73', '#cc79a7'];
 
 // The wasm module in use (its glue's exports: renderPlayground, families, exportShaper,
-// drawSpectrum). The page starts with `lite`, which leaves out the optimisation solver (89 KB
+// drawSpectrum). The page starts with `lite`, which leaves out the optimisation solver (87 KB
 // gzip); a state with a solved family (si, direct, sampled with an active bound) gets the
 // error kind "unavailable" from it, and the page switches to the module with the solver,
 // fetched then (loadSolver). A state in the URL that names si or direct starts with it.
