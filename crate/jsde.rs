@@ -4,7 +4,7 @@
 //! This is serde-wasm-bindgen 0.6.5's `Deserializer` with serde_path_to_error 0.1.20's path
 //! tracking folded in: the same conversions, the same error messages and the same paths, but one
 //! deserializer type instead of a tracking wrapper around another, so every serde visitor is
-//! instantiated once (the wrapper doubled the generated code; see README, *Page performance*).
+//! instantiated once (the wrapper doubled the generated code; see docs/page-performance.md).
 //! The path is kept on a stack: a segment is pushed while a sequence element or a map value is
 //! read, and the first (deepest) failing read records the stack, as path_to_error's `Track` does.
 
