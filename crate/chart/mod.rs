@@ -208,6 +208,11 @@ pub(crate) fn simplify_polyline(
     let mut candidate: Option<Sleeve> = None;
     let mut last = first;
     for p in points {
+        // A point repeated (two samples in one pixel) changes nothing: it is the candidate's
+        // end, or within the tolerance of the anchor, either way as it was the first time.
+        if p == last {
+            continue;
+        }
         last = p;
         loop {
             let d = (f64::from(p.0 - anchor.0), f64::from(p.1 - anchor.1));
@@ -538,6 +543,39 @@ mod tests {
             "a staircase is its corners: {}",
             out.len()
         );
+    }
+
+    /// Repeated points (two samples in one pixel, a quarter of a 4-shaper frame's points) are
+    /// skipped: the same vertices as with each point once, wherever the repeats fall.
+    #[wasm_bindgen_test(unsupported = test)]
+    fn repeated_points_change_no_vertex() {
+        let sine: Vec<(i32, i32)> = (0..800)
+            .map(|i| (i / 2, (120.0 * (f64::from(i) * 0.02).sin()) as i32))
+            .collect();
+        let jumps = vec![
+            (0, 0),
+            (10, 0),
+            (10, 50),
+            (10, -50),
+            (20, 0),
+            (5, 0),
+            (30, 1),
+        ];
+        let steps: Vec<(i32, i32)> = (0..400).map(|x| (x, (x / 40) * 10)).collect();
+        let (mut once, mut repeated) = (Vec::new(), Vec::new());
+        for curve in [sine, jumps, steps] {
+            for tolerance in [0.25, 2.0] {
+                simplify_polyline(curve.iter().copied(), tolerance, &mut once);
+                for times in [2, 3] {
+                    // Every point `times` times, and every third point once more.
+                    let doubled = curve.iter().enumerate().flat_map(|(i, &p)| {
+                        std::iter::repeat_n(p, times + usize::from(i % 3 == 0))
+                    });
+                    simplify_polyline(doubled, tolerance, &mut repeated);
+                    assert_eq!(repeated, once, "tolerance {tolerance}, each point {times}×");
+                }
+            }
+        }
     }
 
     #[wasm_bindgen_test(unsupported = test)]
