@@ -472,12 +472,9 @@ mod tests {
         (px - t * dx).hypot(py - t * dy)
     }
 
-    /// Every input point lies within the tolerance of the simplified polyline's segment that
-    /// replaced it, checked point by point (brute force) on curves of every kind: straight
-    /// lines, a staircase, a sine sampled at two points per pixel, noise, vertical jumps and
-    /// points going back. Straight pieces shrink to their ends.
-    #[wasm_bindgen_test(unsupported = test)]
-    fn simplified_polylines_stay_within_the_tolerance() {
+    /// Polylines of every kind: straight lines, a staircase, a sine sampled at two points per
+    /// pixel, noise, vertical jumps and points going back (with a repeat), one point, none.
+    fn test_curves() -> Vec<Vec<(i32, i32)>> {
         let mut seed = 12345_u64;
         // A linear congruential generator (Knuth's MMIX constants): repeatable noise.
         let mut noise = move || {
@@ -486,7 +483,7 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             ((seed >> 33) % 7) as i32 - 3
         };
-        let curves: Vec<Vec<(i32, i32)>> = vec![
+        vec![
             (0..400).map(|x| (x, 100)).collect(),
             (0..400).map(|x| (x, 3 * x / 7)).collect(),
             (0..400).map(|x| (x, (x / 40) * 10)).collect(),
@@ -506,7 +503,15 @@ mod tests {
             ],
             vec![(7, 7)],
             vec![],
-        ];
+        ]
+    }
+
+    /// Every input point lies within the tolerance of the simplified polyline's segment that
+    /// replaced it, checked point by point (brute force) on curves of every kind
+    /// ([`test_curves`]). Straight pieces shrink to their ends.
+    #[wasm_bindgen_test(unsupported = test)]
+    fn simplified_polylines_stay_within_the_tolerance() {
+        let curves = test_curves();
         let mut out = Vec::new();
         for (k, curve) in curves.iter().enumerate() {
             for tolerance in [0.25, 0.5, 2.0] {
@@ -549,29 +554,16 @@ mod tests {
     /// skipped: the same vertices as with each point once, wherever the repeats fall.
     #[wasm_bindgen_test(unsupported = test)]
     fn repeated_points_change_no_vertex() {
-        let sine: Vec<(i32, i32)> = (0..800)
-            .map(|i| (i / 2, (120.0 * (f64::from(i) * 0.02).sin()) as i32))
-            .collect();
-        let jumps = vec![
-            (0, 0),
-            (10, 0),
-            (10, 50),
-            (10, -50),
-            (20, 0),
-            (5, 0),
-            (30, 1),
-        ];
-        let steps: Vec<(i32, i32)> = (0..400).map(|x| (x, (x / 40) * 10)).collect();
         let (mut once, mut repeated) = (Vec::new(), Vec::new());
-        for curve in [sine, jumps, steps] {
+        for curve in test_curves() {
             for tolerance in [0.25, 2.0] {
                 simplify_polyline(curve.iter().copied(), tolerance, &mut once);
                 for times in [2, 3] {
                     // Every point `times` times, and every third point once more.
-                    let doubled = curve.iter().enumerate().flat_map(|(i, &p)| {
+                    let repeats = curve.iter().enumerate().flat_map(|(i, &p)| {
                         std::iter::repeat_n(p, times + usize::from(i % 3 == 0))
                     });
-                    simplify_polyline(doubled, tolerance, &mut repeated);
+                    simplify_polyline(repeats, tolerance, &mut repeated);
                     assert_eq!(repeated, once, "tolerance {tolerance}, each point {times}×");
                 }
             }
