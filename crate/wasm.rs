@@ -262,6 +262,9 @@ struct PlaygroundView {
     duration: Option<f64>,
     /// Which compared shaper the frequency × damping map shows (index into `shapers`).
     map_shaper: usize,
+    /// The colour of each compared shaper, as a position in the palette (0 … 3); default
+    /// 0, 1, 2, 3. The page leaves a shaper that cannot be designed out and keeps the others'.
+    series_colors: Option<Vec<usize>>,
     /// Resolution of the map.
     map_frequency_points: usize,
     map_damping_points: usize,
@@ -292,6 +295,7 @@ impl Default for PlaygroundView {
             samples: 1000,
             duration: None,
             map_shaper: 0,
+            series_colors: None,
             map_frequency_points: 120,
             map_damping_points: 40,
             damping_to: None,
@@ -762,11 +766,54 @@ fn analysis(
     Ok(a)
 }
 
+#[cfg(feature = "js-playground")]
+/// The charts' colours for `view.seriesColors` (one palette position per compared shaper, each
+/// used once), or the palette in order.
+fn series_colors(
+    slots: Option<&[usize]>,
+    shapers: usize,
+) -> Result<[plotters::style::RGBColor; 4], Error> {
+    let palette = chart::SERIES_COLORS;
+    let Some(slots) = slots else {
+        return Ok(palette);
+    };
+    let field = "view.seriesColors";
+    if slots.len() != shapers {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "give one colour per compared shaper: {shapers}, got {}",
+                slots.len()
+            ),
+        ));
+    }
+    let mut colors = palette;
+    for (k, &slot) in slots.iter().enumerate() {
+        if slot >= palette.len() {
+            return Err(Error::invalid(
+                format!("{field}[{k}]"),
+                format!(
+                    "must be a palette position, 0 … {}, got {slot}",
+                    palette.len() - 1
+                ),
+            ));
+        }
+        if slots[..k].contains(&slot) {
+            return Err(Error::invalid(
+                format!("{field}[{k}]"),
+                format!("colour {slot} is already another shaper's"),
+            ));
+        }
+        colors[k] = palette[slot];
+    }
+    Ok(colors)
+}
+
 /// `renderPlayground(state, canvases)`: everything one frame of the page needs, in one call.
 ///
 /// `state = { modes, shapers: [{ family, …parameters }] (1 … 4; or `shaper` for one),
 /// view: { fromHz, toHz, points, vtol, scv, pixelRatio, mismatch, command, plant, samples,
-/// duration, mapShaper, mapFrequencyPoints, mapDampingPoints, dampingTo, dampingPoints,
+/// duration, mapShaper, seriesColors, mapFrequencyPoints, mapDampingPoints, dampingTo, dampingPoints,
 /// spectrumPoints } }` (README, "JavaScript API"); `canvases = { impulses?, sensitivity?,
 /// damping?, map?, response?, command?, spectrum?, robustness? }` (HTMLCanvasElements).
 /// Designs every shaper, computes its sensitivity curve (at the first mode's damping),
@@ -825,6 +872,7 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
             ),
         )));
     }
+    let colors = series_colors(view.series_colors.as_deref(), specs.len()).map_err(js_error)?;
     count_in(
         "view.mapFrequencyPoints",
         view.map_frequency_points,
@@ -915,6 +963,7 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
         } else {
             1.0
         },
+        colors,
     };
     let backend = |key: &str| canvas(&canvases, key).and_then(Canvas::new);
     let spectra = match &impulse_spectra {

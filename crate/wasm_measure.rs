@@ -438,6 +438,7 @@ pub fn draw_spectrum(
             .pixel_ratio
             .filter(|r| r.is_finite() && *r > 0.0)
             .unwrap_or(1.0),
+        ..ChartStyle::default()
     };
     let backend = Canvas::new(canvas).ok_or_else(|| {
         js_error(Error::Render {

@@ -121,12 +121,46 @@ fn sensitivity_chart_has_curve_vtol_and_mode_marker() {
     assert!(longest >= 200, "curve polyline has {longest} points");
 }
 
+/// `ChartStyle::colors` colours the series in order: ZV and ZVD drawn with the palette's third
+/// and fourth colours (#009E73, #CC79A7) use neither of the first two.
+#[test]
+fn style_colors_colour_the_series_in_order() {
+    let mode = Mode::new(2.0, 0.05).unwrap();
+    let (a, b) = (zv(&mode).unwrap(), zvd(&mode).unwrap());
+    let [c0, c1, c2, c3] = input_shaping::chart::SERIES_COLORS;
+    let style = ChartStyle {
+        colors: [c2, c3, c0, c1],
+        ..ChartStyle::default()
+    };
+    let default =
+        svg(|x| draw_impulses(x, &[("ZV", &a), ("ZVD", &b)], &ChartStyle::default()).unwrap())
+            .to_uppercase();
+    let picked =
+        svg(|x| draw_impulses(x, &[("ZV", &a), ("ZVD", &b)], &style).unwrap()).to_uppercase();
+    for hex in ["#0072B2", "#D55E00"] {
+        assert!(default.contains(hex) && !picked.contains(hex), "{hex}");
+    }
+    for hex in ["#009E73", "#CC79A7"] {
+        assert!(picked.contains(hex) && !default.contains(hex), "{hex}");
+    }
+}
+
 #[test]
 fn scale_enlarges_fonts() {
     let mode = Mode::new(2.0, 0.0).unwrap();
     let s = zv(&mode).unwrap();
-    let small = svg(|a| draw_impulses(a, &[("ZV", &s)], &ChartStyle { scale: 1.0 }).unwrap());
-    let large = svg(|a| draw_impulses(a, &[("ZV", &s)], &ChartStyle { scale: 2.0 }).unwrap());
+    let small = svg(|a| draw_impulses(a, &[("ZV", &s)], &ChartStyle::default()).unwrap());
+    let large = svg(|a| {
+        draw_impulses(
+            a,
+            &[("ZV", &s)],
+            &ChartStyle {
+                scale: 2.0,
+                ..ChartStyle::default()
+            },
+        )
+        .unwrap()
+    });
     let ratio = caption_font_size(&large) / caption_font_size(&small);
     assert!((ratio - 2.0).abs() < 1e-9, "caption font ratio {ratio}");
 }

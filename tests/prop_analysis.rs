@@ -148,7 +148,7 @@ proptest! {
             let mut svg = String::new();
             {
                 let area = SVGBackend::with_string(&mut svg, (320, 200)).into_drawing_area();
-                let r = chart::draw_sensitivity_map(&area, &m, Some(vtol), &[(from_hz, z0)], &ChartStyle { scale: vtol * 4.0 });
+                let r = chart::draw_sensitivity_map(&area, &m, Some(vtol), &[(from_hz, z0)], &ChartStyle { scale: vtol * 4.0, ..ChartStyle::default() });
                 ok_or_typed(r, |_| Ok(()))?;
             }
             let _ = chart::map::contour_segments(&m, vtol);
@@ -200,7 +200,7 @@ proptest! {
         modes_hz in prop::collection::vec(num(0.1..10.0), 0..3),
         scale in num(0.5..3.0),
     ) {
-        let style = ChartStyle { scale };
+        let style = ChartStyle { scale, ..ChartStyle::default() };
         let series: Vec<(&str, &Shaper)> = shapers.iter().map(|s| ("s", s)).collect();
         let c = SensitivityCurve {
             frequency_hz: curve.iter().map(|p| p.0).collect(),

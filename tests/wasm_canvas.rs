@@ -98,6 +98,73 @@ fn render_playground_draws_both_charts_and_keeps_them_on_error() {
     assert_eq!(pixels(&sens), before_sens, "sensitivity chart kept");
 }
 
+/// Counts pixels within 30 of `rgb` in every channel.
+fn pixels_of(data: &[u8], rgb: (i32, i32, i32)) -> usize {
+    data.chunks(4)
+        .filter(|p| {
+            (p[0] as i32 - rgb.0).abs() < 30
+                && (p[1] as i32 - rgb.1).abs() < 30
+                && (p[2] as i32 - rgb.2).abs() < 30
+        })
+        .count()
+}
+
+/// `view.seriesColors` gives each compared shaper its palette colour: the page leaves a shaper
+/// it cannot design out and the others keep theirs (web/main.js). Two shapers drawn in the
+/// palette's third and fourth colours (green, pink) have no pixel of the first two; a wrong
+/// list is an error at the field and draws nothing.
+#[wasm_bindgen_test]
+fn series_colors_pick_the_palette_positions() {
+    let blue = (0, 114, 178);
+    let vermillion = (213, 94, 0);
+    let green = (0, 158, 115);
+    let pink = (204, 121, 167);
+    let state = |colors: &str| {
+        JSON::parse(&format!(
+            r#"{{"modes":[{{"frequencyHz":2,"damping":0.05}}],"shapers":[{{"family":"zv"}},{{"family":"zvd"}}],"view":{{"seriesColors":{colors}}}}}"#
+        ))
+        .unwrap()
+    };
+    let draw = |colors: &str| {
+        let imp = canvas(640, 360);
+        let canvases = js_sys::Object::new();
+        Reflect::set(&canvases, &"impulses".into(), &imp).unwrap();
+        let r = wasm::render_playground(state(colors), canvases.into());
+        (r, pixels(&imp))
+    };
+    let (r, default) = draw("null");
+    r.unwrap();
+    assert!(pixels_of(&default, blue) > 100 && pixels_of(&default, vermillion) > 100);
+    assert_eq!(pixels_of(&default, green) + pixels_of(&default, pink), 0);
+
+    let (r, picked) = draw("[2, 3]");
+    r.unwrap();
+    assert!(pixels_of(&picked, green) > 100, "ZV in green");
+    assert!(pixels_of(&picked, pink) > 100, "ZVD in pink");
+    assert_eq!(pixels_of(&picked, blue) + pixels_of(&picked, vermillion), 0);
+
+    for (colors, field) in [
+        ("[2]", "view.seriesColors"),
+        ("[0, 4]", "view.seriesColors[1]"),
+        ("[1, 1]", "view.seriesColors[1]"),
+    ] {
+        let (r, untouched) = draw(colors);
+        let err: js_sys::Error = r.unwrap_err().dyn_into().unwrap();
+        assert_eq!(
+            Reflect::get(&err, &"field".into())
+                .unwrap()
+                .as_string()
+                .as_deref(),
+            Some(field),
+            "{colors}"
+        );
+        assert!(
+            untouched.chunks(4).all(|p| p[3] == 0),
+            "{colors}: nothing drawn"
+        );
+    }
+}
+
 #[wasm_bindgen_test]
 fn missing_canvases_are_skipped() {
     let state = JSON::parse(r#"{"modes":[{"frequencyHz":5}],"shaper":{"family":"zv"}}"#).unwrap();

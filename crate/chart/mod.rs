@@ -33,16 +33,23 @@ pub const SERIES_COLORS: [RGBColor; 4] = [
 ];
 
 /// Look of a chart: `scale` multiplies fonts, strokes and margins (pass the device pixel ratio
-/// so a chart drawn on a high-DPI canvas reads at the same size).
+/// so a chart drawn on a high-DPI canvas reads at the same size); `colors` are the overlaid
+/// series' colours, in order.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ChartStyle {
     /// Multiplier for font sizes, stroke widths and margins (≥ 0.25).
     pub scale: f64,
+    /// Colour of series k (cycling past the fourth); default [`SERIES_COLORS`]. A page that
+    /// leaves a series out can keep the others' colours by listing them.
+    pub colors: [RGBColor; 4],
 }
 
 impl Default for ChartStyle {
     fn default() -> Self {
-        ChartStyle { scale: 1.0 }
+        ChartStyle {
+            scale: 1.0,
+            colors: SERIES_COLORS,
+        }
     }
 }
 
@@ -59,7 +66,7 @@ impl ChartStyle {
 
     /// Colour of series `i`.
     pub(crate) fn color(&self, i: usize) -> RGBColor {
-        SERIES_COLORS[i % SERIES_COLORS.len()]
+        self.colors[i % self.colors.len()]
     }
 }
 
