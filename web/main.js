@@ -1,7 +1,8 @@
 // The playground: one state object (state.js), editors built from it, one call into wasm per
 // frame (renderPlayground), and the numbers, charts and exports of the last good result. A bad
 // value shows its message next to its field (matched by the error's `field` against the
-// inputs' data-field) while the last good charts and numbers stay.
+// inputs' data-field) while the last good charts and numbers stay; with nothing good on screen
+// yet (a link, a reload), a shaper that cannot be designed is left out instead (render).
 import * as lite from '../pkg/page/playground.js';
 import { DEFAULT_STATE, PRESETS, MAX_MODES, MAX_SHAPERS, checkState, clone, toHash, fromHash } from './state.js';
 import { COMMAND_PARAMS, commandFor } from './params.js';
@@ -23,7 +24,7 @@ const SOLVED_FAMILIES = new Set(['si', 'direct']);
 
 let state = clone(DEFAULT_STATE);
 let familyTable = [];
-let lastGood = null; // { state, result }
+let lastGood = null; // { state, result, kept: the shapers drawn (indices), left: those left out }
 
 // ---------- small DOM helpers (text only: user text never reaches innerHTML) ----------
 function el(tag, props = {}, ...children) {
@@ -260,11 +261,12 @@ function showError(error) {
 /** The impulses each impulse table shows, as JSON (by table body). */
 const impulseKeys = new WeakMap();
 
-function showResults(result, st) {
+function showResults(result, st, kept) {
   const { results } = result;
-  const labels = JSON.stringify(results.map((r) => r.label));
+  const color = (k) => COLORS[kept[k]]; // a shaper left out keeps the others' colours
+  const labels = JSON.stringify(results.map((r, k) => [r.label, kept[k]]));
   rebuildIf($('summary').tHead, labels, () => [el('tr', {}, el('th', { scope: 'col' }, ''),
-    ...results.map((r, k) => el('th', { scope: 'col' }, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), r.label)))]);
+    ...results.map((r, k) => el('th', { scope: 'col' }, el('span', { class: 'swatch', style: `background:${color(k)}` }), r.label)))]);
   const period = 1 / (st.modes[0].frequencyHz * Math.sqrt(1 - st.modes[0].damping ** 2));
   const vtolPct = fmt(st.view.vtol * 100, 4);
   const rows = [
@@ -286,10 +288,10 @@ function showResults(result, st) {
   rows.push(['Klipper max accel, smoothing ≤ 0.12 mm (mm/s²)', (r) => (r.klipper == null ? 'n/a' : maxAccel(r.klipper.maxAccel))]);
   syncRows($('summary').tBodies[0], rows.map(([name, f]) => [name, ...results.map((r) => f(r))]));
 
-  showSimulation(result);
+  showSimulation(result, color);
 
   rebuildIf($('impulse-tables'), labels, () => results.map((r, k) => el('table', { class: 'impulses', id: `impulses-${k}` },
-    el('caption', {}, el('span', { class: 'swatch', style: `background:${COLORS[k]}` }), r.label),
+    el('caption', {}, el('span', { class: 'swatch', style: `background:${color(k)}` }), r.label),
     el('thead', {}, el('tr', {}, el('th', { scope: 'col' }, '#'), el('th', { scope: 'col' }, 'time (s)'), el('th', { scope: 'col' }, 'amplitude'))),
     el('tbody', {}))));
   results.forEach((r, k) => {
@@ -309,12 +311,12 @@ function showResults(result, st) {
   showExport();
 }
 
-/** The simulated move's metrics: the unshaped command and every shaper. */
-function showSimulation(result) {
+/** The simulated move's metrics: the unshaped command and every shaper (`color(k)` of result k). */
+function showSimulation(result, color) {
   const sim = result.simulation;
   const columns = [{ label: 'Unshaped', color: '#6e6e6e', m: sim.unshaped },
-    ...result.results.map((r, k) => ({ label: r.label, color: COLORS[k], m: r.simulation }))];
-  rebuildIf($('simulation-summary').tHead, JSON.stringify(columns.map((c) => c.label)), () => [el('tr', {}, el('th', { scope: 'col' }, ''),
+    ...result.results.map((r, k) => ({ label: r.label, color: color(k), m: r.simulation }))];
+  rebuildIf($('simulation-summary').tHead, JSON.stringify(columns.map((c) => [c.label, c.color])), () => [el('tr', {}, el('th', { scope: 'col' }, ''),
     ...columns.map((c) => el('th', { scope: 'col' }, el('span', { class: 'swatch', style: `background:${c.color}` }), c.label)))]);
   const pct = (x) => (x == null ? '—' : Math.abs(x) < 1e-9 ? '≈ 0' : fmt(x, 4));
   const num = (x, d = 5) => (x == null ? '—' : fmt(x, d));
@@ -400,15 +402,73 @@ function update() {
   Object.values(canvases).forEach(sizeCanvas);
   const st = { ...state, view: { ...state.view, pixelRatio: window.devicePixelRatio || 1 } };
   try {
-    const result = api.renderPlayground(st, canvases);
-    lastGood = { state: clone(state), result };
-    showResults(result, state);
+    const { result, kept, left } = render(st, canvases);
+    lastGood = { state: clone(state), result, kept, left: left.map((l) => l.index) };
+    showResults(result, state, kept);
     document.body.dataset.ready = 'true';
+    if (left.length) {
+      left.forEach((l) => showError(l.error));
+      const names = left.map((l) => l.index + 1).sort((a, b) => a - b);
+      $('general-error').textContent = names.length > 1
+        ? `Shapers ${names.slice(0, -1).join(', ')} and ${names.at(-1)} are left out of the charts and tables: they cannot be designed as they are (the messages are at the shapers).`
+        : `Shaper ${names[0]} is left out of the charts and tables: it cannot be designed as it is (the message is at the shaper).`;
+    }
   } catch (error) {
     if (error?.kind === 'unavailable' && api === lite) awaitSolver(error);
-    else showError(error);
+    else {
+      showError(error);
+      // Nothing good to keep on screen (a link or a reload): say why the charts are empty.
+      if (!lastGood && !$('general-error').textContent) $('general-error').textContent = `Nothing can be drawn until this is fixed: ${error?.message ?? error}`;
+    }
   }
   return performance.now() - t0;
+}
+
+/** The compared shaper an error is about (its index in the state drawn), or -1. */
+function shaperOf(error) {
+  const m = /^shapers\[(\d+)\]/.exec(typeof error?.field === 'string' ? error.field : '');
+  return m ? Number(m[1]) : -1;
+}
+
+/** The error of shaper `j` of a state drawn without some shapers, named as shaper `k` of the
+ * whole state (its field and the message's leading field). */
+function renamed(error, j, k) {
+  if (j === k) return error;
+  const from = `shapers[${j}]`;
+  const to = `shapers[${k}]`;
+  const message = error?.message ?? String(error);
+  return { kind: error?.kind, field: to + error.field.slice(from.length), message: message.startsWith(from) ? to + message.slice(from.length) : message };
+}
+
+/**
+ * Draws the state. A shaper that cannot be designed is left out, the others keeping their
+ * colours, when nothing better is on screen: on the first frame (a link or a reload), or when
+ * the last frame had left it out too (edits elsewhere still draw). Any other error is thrown,
+ * so the last good charts stay. Returns the result, the shapers drawn (indices) and those left
+ * out with their errors.
+ */
+function render(st, canvases) {
+  let kept = st.shapers.map((_, i) => i);
+  const left = [];
+  for (;;) {
+    const drawn = kept.length === st.shapers.length ? st : {
+      ...st,
+      shapers: kept.map((i) => st.shapers[i]),
+      view: { ...st.view, mapShaper: Math.max(0, kept.indexOf(st.view.mapShaper ?? 0)), seriesColors: kept },
+    };
+    try {
+      return { result: api.renderPlayground(drawn, canvases), kept, left };
+    } catch (error) {
+      const j = shaperOf(error);
+      const k = j < 0 ? -1 : kept[j];
+      const named = j < 0 ? error : renamed(error, j, k);
+      const mayLeave = k >= 0 && kept.length > 1 && error?.kind !== 'unavailable'
+        && (!lastGood || lastGood.left.includes(k));
+      if (!mayLeave) throw named;
+      left.push({ index: k, error: named });
+      kept = kept.filter((i) => i !== k);
+    }
+  }
 }
 
 let frame = 0;

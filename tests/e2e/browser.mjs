@@ -37,6 +37,10 @@ export async function openBrowser() {
       await page.waitForSelector('body[data-ready="true"]', { timeout: 20000 });
       return { page, problems, fetched };
     },
+    /** A fresh page, nothing loaded (for pages that never become ready). */
+    browserPage({ width = 1280, height = 800 } = {}) {
+      return browser.newPage({ viewport: { width, height } });
+    },
     async close() {
       await browser.close();
       await new Promise((ok) => server.close(ok));

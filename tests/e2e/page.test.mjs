@@ -261,6 +261,74 @@ test('a bad value shows a message at its field and keeps the last good result', 
   await page.close();
 });
 
+/** Impulse rows equal to `want` ([time, amplitude]) to the table's 10 digits. */
+function assertClose(rows, want) {
+  assert.equal(rows.length, want.length);
+  rows.forEach(([t, a], i) => {
+    assert.ok(Math.abs(t - want[i][0]) < 1e-9 && Math.abs(a - want[i][1]) < 1e-9, `impulse ${i}: ${[t, a]} vs ${want[i]}`);
+  });
+}
+
+/** Pixels of a canvas within 30 of `rgb` in every channel. */
+async function colorPixels(page, id, rgb) {
+  return page.evaluate(([canvasId, [r, g, b]]) => {
+    const c = document.getElementById(canvasId);
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - r) < 30 && Math.abs(d[i + 1] - g) < 30 && Math.abs(d[i + 2] - b) < 30) n++;
+    return n;
+  }, [id, rgb]);
+}
+
+test('a link with a shaper that cannot be designed draws the others in their colours, says so, and keeps the last good charts once all drew', async () => {
+  const BLUE = [0, 114, 178];
+  const VERMILLION = [213, 94, 0];
+  const GREEN = [0, 158, 115];
+  // Shaper 2's EI hump of 90 % is out of range: nothing good is on screen yet, so it is left out.
+  const state = { modes: [{ frequencyHz: 2, damping: 0.05 }], shapers: [{ family: 'zv' }, { family: 'ei', vtol: 0.9 }, { family: 'zvd' }] };
+  const { page, problems } = await env.page({ hash: `#state=${encodeURIComponent(JSON.stringify(state))}` });
+  assert.match(await page.textContent('#general-error'), /^Shaper 2 is left out of the charts and tables/);
+  assert.match(await page.textContent('.field:has([data-field="shapers[1].vtol"]) .error'), /^shapers\[1\]\.vtol: tolerable vibration must lie between 0\.001 and 0\.5/);
+  const heads = () => page.$$eval('#summary thead th', (th) => th.slice(1).map((h) => [h.textContent, getComputedStyle(h.querySelector('.swatch')).backgroundColor]));
+  assert.deepEqual(await heads(), [['ZV', 'rgb(0, 114, 178)'], ['ZVD', 'rgb(0, 158, 115)']]);
+  assertClose(await impulseRows(page, 1), zvd(2, 0.05));
+  assert.ok(await colorPixels(page, 'impulses-chart', BLUE) > 100, 'ZV in blue');
+  assert.ok(await colorPixels(page, 'impulses-chart', GREEN) > 100, 'ZVD keeps its green');
+  assert.equal(await colorPixels(page, 'impulses-chart', VERMILLION), 0, 'nothing in the left-out shaper\'s colour');
+  // An edit elsewhere still draws, the shaper still left out.
+  await type(page, 'mode-0-frequency', 3);
+  await settle(page);
+  assertClose(await impulseRows(page, 1), zvd(3, 0.05));
+  assert.match(await page.textContent('#general-error'), /^Shaper 2 is left out/);
+  // Fixed: all three drawn, in their colours.
+  await page.selectOption('#shaper-1-family', 'zvdd');
+  await settle(page);
+  assert.equal(await page.textContent('#general-error'), '');
+  assert.deepEqual((await heads()).map((h) => h[1]), ['rgb(0, 114, 178)', 'rgb(213, 94, 0)', 'rgb(0, 158, 115)']);
+  assert.ok(await colorPixels(page, 'impulses-chart', VERMILLION) > 100, 'ZVDD in vermillion');
+  // Broken again once everything drew: the message at the field, the last good charts stay.
+  await page.selectOption('#shaper-1-family', 'zvdn');
+  await settle(page);
+  const drawn = await canvasInfo(page, 'impulses-chart');
+  await type(page, 'shaper-1-derivatives', 99);
+  await settle(page);
+  assert.match(await page.textContent('.field:has(#shaper-1-derivatives) .error'), /too large/);
+  assert.equal(await page.textContent('#general-error'), '');
+  assert.equal((await canvasInfo(page, 'impulses-chart')).hash, drawn.hash);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('a link that cannot be drawn at all says why at the field and on top', async () => {
+  const state = { modes: [{ frequencyHz: 2, damping: 0.05 }], shapers: [{ family: 'ei', vtol: 0.9 }] };
+  const page = await env.browserPage();
+  await page.goto(`${env.url}#state=${encodeURIComponent(JSON.stringify(state))}`);
+  await page.waitForFunction(() => document.getElementById('general-error')?.textContent);
+  assert.match(await page.textContent('#general-error'), /^Nothing can be drawn until this is fixed: shapers\[0\]\.vtol: /);
+  assert.match(await page.textContent('.field:has([data-field="shapers[0].vtol"]) .error'), /^shapers\[0\]\.vtol: /);
+  await page.close();
+});
+
 test('the state lives in the URL: reload, back/forward, and hostile hashes', async () => {
   const { page, problems } = await env.page();
   await type(page, 'mode-0-frequency', 7);
