@@ -442,10 +442,11 @@ function renamed(error, j, k) {
 
 /**
  * Draws the state. A shaper that cannot be designed is left out, the others keeping their
- * colours, when nothing better is on screen: on the first frame (a link or a reload), or when
- * the last frame had left it out too (edits elsewhere still draw). Any other error is thrown,
- * so the last good charts stay. Returns the result, the shapers drawn (indices) and those left
- * out with their errors.
+ * colours, when nothing better is on screen: on the first frame (a link or a reload), and
+ * while the last frame had left shapers out (edits elsewhere still draw; adding or removing a
+ * shaper may move the one left out). Once every shaper drew, an error is thrown instead, so the
+ * last good charts stay. Returns the result, the shapers drawn (indices) and those left out
+ * with their errors.
  */
 function render(st, canvases) {
   let kept = st.shapers.map((_, i) => i);
@@ -463,7 +464,7 @@ function render(st, canvases) {
       const k = j < 0 ? -1 : kept[j];
       const named = j < 0 ? error : renamed(error, j, k);
       const mayLeave = k >= 0 && kept.length > 1 && error?.kind !== 'unavailable'
-        && (!lastGood || lastGood.left.includes(k));
+        && (!lastGood || lastGood.left.length > 0);
       if (!mayLeave) throw named;
       left.push({ index: k, error: named });
       kept = kept.filter((i) => i !== k);

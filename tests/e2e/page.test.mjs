@@ -300,6 +300,16 @@ test('a link with a shaper that cannot be designed draws the others in their col
   await settle(page);
   assertClose(await impulseRows(page, 1), zvd(3, 0.05));
   assert.match(await page.textContent('#general-error'), /^Shaper 2 is left out/);
+  // A shaper added in the meantime and failing too is left out as well.
+  await page.click('#add-shaper');
+  await page.selectOption('#shaper-3-family', 'ei');
+  await type(page, 'shaper-3-vtol', 80);
+  await settle(page);
+  assert.match(await page.textContent('#general-error'), /^Shapers 2 and 4 are left out/);
+  assert.deepEqual((await heads()).map((h) => h[0]), ['ZV', 'ZVD']);
+  await page.click('button[aria-label="Remove shaper 4"]');
+  await settle(page);
+  assert.match(await page.textContent('#general-error'), /^Shaper 2 is left out/);
   // Fixed: all three drawn, in their colours.
   await page.selectOption('#shaper-1-family', 'zvdd');
   await settle(page);
