@@ -24,7 +24,7 @@ const SOLVED_FAMILIES = new Set(['si', 'direct']);
 
 let state = clone(DEFAULT_STATE);
 let familyTable = [];
-let lastGood = null; // { state, result, kept: the shapers drawn (indices), left: those left out }
+let lastGood = null; // { state, result, left: the shapers it left out (indices) }
 
 // ---------- small DOM helpers (text only: user text never reaches innerHTML) ----------
 function el(tag, props = {}, ...children) {
@@ -403,7 +403,7 @@ function update() {
   const st = { ...state, view: { ...state.view, pixelRatio: window.devicePixelRatio || 1 } };
   try {
     const { result, kept, left } = render(st, canvases);
-    lastGood = { state: clone(state), result, kept, left: left.map((l) => l.index) };
+    lastGood = { state: clone(state), result, left: left.map((l) => l.index) };
     showResults(result, state, kept);
     document.body.dataset.ready = 'true';
     if (left.length) {
