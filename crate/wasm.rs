@@ -96,7 +96,7 @@ fn mode_from_js(value: JsValue, what: &str) -> Result<Mode, Error> {
 
 /// `design(spec)`: `spec = { family, modes: [{ frequencyHz, damping }], …parameters }` →
 /// `{ impulses: [{ time, amplitude }], duration }`.
-#[cfg(feature = "js-api")]
+#[cfg(any(feature = "js-api", feature = "js-designer"))]
 #[wasm_bindgen]
 pub fn design(spec: JsValue) -> Result<JsValue, JsValue> {
     let request: DesignRequest = from_js(spec, "").map_err(js_error)?;
@@ -235,6 +235,14 @@ struct PlaygroundState {
     shaper: Option<ShaperSpec>,
     #[serde(default)]
     view: PlaygroundView,
+    /// Shapers designed elsewhere, by index into the compared shapers (`null` or missing: design
+    /// it here). The page designs the solved families in a worker and hands their impulses
+    /// (as `design` returns them) back with the state, so the module on the main thread needs
+    /// no solver and never waits for one. Each is checked as `exportShaper` checks a shaper
+    /// and used for the spec at its index, which still gives the label, the family and the
+    /// shaped move.
+    #[serde(default)]
+    designed: Vec<Option<ShaperData>>,
 }
 
 #[derive(Deserialize)]
@@ -611,6 +619,8 @@ struct Analysis {
 #[derive(Clone, PartialEq)]
 struct AnalysisKey {
     specs: Vec<ShaperSpec>,
+    /// The impulses of the shapers designed elsewhere (`PlaygroundState::designed`).
+    designed: Vec<Option<Vec<crate::shaper::Impulse>>>,
     modes: Vec<ModeSpec>,
     /// vtol, scv, the V(f) range and points, the damping range and points, the map's shaper
     /// and resolution, the spectrum's points (floats as bits).
@@ -631,6 +641,7 @@ thread_local! {
 #[allow(clippy::too_many_arguments)]
 fn analysis(
     specs: &[ShaperSpec],
+    designed: &[Option<Shaper>],
     labels: &[String],
     mode_specs: &[ModeSpec],
     modes: &[Mode],
@@ -642,6 +653,10 @@ fn analysis(
 ) -> Result<Analysis, JsValue> {
     let key = AnalysisKey {
         specs: specs.to_vec(),
+        designed: designed
+            .iter()
+            .map(|d| d.as_ref().map(|s| s.impulses().to_vec()))
+            .collect(),
         modes: mode_specs.to_vec(),
         numbers: [
             view.vtol.to_bits(),
@@ -671,7 +686,10 @@ fn analysis(
     let mut shapers = Vec::with_capacity(specs.len());
     for (k, spec) in specs.iter().enumerate() {
         let at = |e: Error| js_error(e.within(&format!("shapers[{k}]")));
-        let shaper = design::design_for(spec, modes).map_err(at)?;
+        let shaper = match designed.get(k) {
+            Some(Some(shaper)) => shaper.clone(),
+            _ => design::design_for(spec, modes).map_err(at)?,
+        };
         let curve = vibration::sensitivity(&shaper, options).map_err(in_view)?;
         let insensitivity = modes
             .iter()
@@ -848,6 +866,27 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
             limit: MAX_COMPARED as f64,
         }));
     }
+    if state.designed.len() > specs.len() {
+        return Err(js_error(Error::invalid(
+            "designed",
+            format!(
+                "has {} entries for {} compared shapers",
+                state.designed.len(),
+                specs.len()
+            ),
+        )));
+    }
+    let designed = state
+        .designed
+        .iter()
+        .enumerate()
+        .map(|(k, d)| {
+            d.as_ref()
+                .map(|d| Shaper::from_data(d).map_err(|e| e.within(&format!("designed[{k}]"))))
+                .transpose()
+        })
+        .collect::<Result<Vec<Option<Shaper>>, Error>>()
+        .map_err(js_error)?;
     let view = &state.view;
     let f_max = modes.iter().map(Mode::frequency_hz).fold(0.0_f64, f64::max);
     let options = SensitivityOptions {
@@ -904,6 +943,7 @@ pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, J
         impulse_spectra,
     } = analysis(
         &specs,
+        &designed,
         &labels,
         &state.modes,
         &modes,

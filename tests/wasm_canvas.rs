@@ -396,3 +396,72 @@ fn labels_write_in_the_derivative_and_hump_counts() {
         .collect();
     assert_eq!(labels, ["ZV-D³", "ZV-D¹²", "4-hump EI #3", "4-hump EI #4"]);
 }
+
+/// `state.designed`: a shaper designed elsewhere (the page's design worker) and handed back
+/// with the state draws exactly what designing it here draws, is used as given (its label and
+/// family still come from the spec), is part of what the kept analysis depends on, and a bad
+/// one is refused at its field.
+#[wasm_bindgen_test]
+fn shapers_designed_elsewhere_are_used_as_given() {
+    let canvases = js_sys::Object::new();
+    for key in ["impulses", "sensitivity", "damping", "map", "spectrum"] {
+        Reflect::set(&canvases, &key.into(), &canvas(320, 200)).unwrap();
+    }
+    let modes = r#"[{"frequencyHz":2,"damping":0.05},{"frequencyHz":5.5,"damping":0.02}]"#;
+    let si = r#"{"family":"si","vtol":0.05,"insensitivity":0.3}"#;
+    let state = |designed: &str| {
+        JSON::parse(&format!(
+            r#"{{"modes":{modes},"shapers":[{si},{{"family":"zvd"}}],"designed":{designed},
+                "view":{{"command":{{"kind":"trapezoid","distance":1,"maxVelocity":0.8,"maxAcceleration":8}}}}}}"#
+        ))
+        .unwrap()
+    };
+    let json = |v: &JsValue| String::from(JSON::stringify(v).unwrap());
+    let here = json(&wasm::render_playground(state("[]"), canvases.clone().into()).unwrap());
+    let spec = JSON::parse(&format!(
+        r#"{{"family":"si","vtol":0.05,"insensitivity":0.3,"modes":{modes}}}"#
+    ))
+    .unwrap();
+    let designed = json(&wasm::design(spec).unwrap());
+    // Handed back: the same frame, number for number (`designed` is part of the kept
+    // analysis's key, so this frame is computed from the handed shaper).
+    let zv_modes = JSON::parse(&format!(r#"{{"family":"zv","modes":{modes}}}"#)).unwrap();
+    let zv = json(&wasm::design(zv_modes).unwrap());
+    let other = wasm::render_playground(
+        state(&format!("[{zv}]")),
+        JsValue::from(js_sys::Object::new()),
+    )
+    .unwrap();
+    let handed = json(
+        &wasm::render_playground(state(&format!("[{designed}, null]")), canvases.into()).unwrap(),
+    );
+    assert_eq!(
+        handed, here,
+        "a handed-back design draws what designing it here draws"
+    );
+    // Used as given: a ZV handed for the SI spec is what the frame shows, under the SI's label.
+    let first = js_sys::Array::from(&Reflect::get(&other, &"results".into()).unwrap()).get(0);
+    let get = |k: &str| Reflect::get(&first, &k.into()).unwrap();
+    assert_eq!(json(&get("shaper")), zv);
+    assert_eq!(get("family").as_string().unwrap(), "si");
+    assert!(
+        get("label").as_string().unwrap().starts_with("SI"),
+        "{:?}",
+        get("label")
+    );
+    // Refused at the field.
+    let field = |designed: &str| {
+        let err: js_sys::Error = wasm::render_playground(state(designed), JsValue::NULL)
+            .unwrap_err()
+            .dyn_into()
+            .unwrap();
+        let field = Reflect::get(&err, &"field".into()).unwrap().as_string();
+        (field.unwrap_or_default(), String::from(err.message()))
+    };
+    let (f, m) = field(&format!("[null, null, {zv}]"));
+    assert_eq!(f, "designed", "{m}");
+    let (f, m) = field(r#"[null, {"impulses":[]}]"#);
+    assert!(f.starts_with("designed[1]"), "{f}: {m}");
+    let (f, m) = field(r#"[{"impulses":[{"time":0,"amplitude":"one"}]}]"#);
+    assert!(f.starts_with("designed[0]"), "{f}: {m}");
+}
