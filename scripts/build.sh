@@ -28,8 +28,8 @@ fi
 #                                 solver: the solved families (si, direct, bounded sampled)
 #                                 answer "unavailable" (the measured-data worker ranks shapers
 #                                 with it too, handed over compiled);
-#   pkg/page/playground_solver.js the same with the solver (js-playground + solver), fetched
-#                                 instead when the state has a solved family;
+#   pkg/page/designer.js          `design` and the solver (js-designer + solver), for the page's
+#                                 design worker, fetched when a solved family is first shown;
 #   pkg/page/recording.js         what its measured-data worker calls (js-recording), fetched
 #                                 only when a recording is opened.
 # The linker keeps only the code an export reaches, so the page's modules are smaller than the
@@ -74,18 +74,18 @@ build_module js-api pkg input_shaping
 shrink pkg/input_shaping_bg.wasm & pids+=($!)
 build_module js-playground pkg/page playground
 shrink pkg/page/playground_bg.wasm & pids+=($!)
-build_module js-playground,solver pkg/page playground_solver
-shrink pkg/page/playground_solver_bg.wasm & pids+=($!)
+build_module js-designer,solver pkg/page designer
+shrink pkg/page/designer_bg.wasm & pids+=($!)
 build_module js-recording pkg/page recording
 shrink pkg/page/recording_bg.wasm & pids+=($!)
 for pid in "${pids[@]}"; do wait "$pid"; done
 bash scripts/bundle.sh
 
 gz() { gzip -9 -c "$1" | wc -c; }
-for m in pkg/input_shaping pkg/page/playground pkg/page/playground_solver pkg/page/recording; do
+for m in pkg/input_shaping pkg/page/playground pkg/page/designer pkg/page/recording; do
   printf '[build] %s_bg.wasm: %d bytes (%d gzip); glue JS %d bytes gzip\n' \
     "$m" "$(wc -c < "${m}_bg.wasm")" "$(gz "${m}_bg.wasm")" "$(gz "$m.js")"
 done
-for b in pkg/page/main.js pkg/page/measure_worker.js; do
+for b in pkg/page/main.js pkg/page/measure_worker.js pkg/page/design_worker.js; do
   printf '[build] %s (esbuild): %d bytes gzip\n' "$b" "$(gz "$b")"
 done

@@ -12,19 +12,18 @@ import { setupMeasure } from './measure.js';
 const $ = (id) => document.getElementById(id);
 const COLORS = ['#0072b2', '#d55e00', '#009e73', '#cc79a7'];
 
-// The wasm module in use (its glue's exports: renderPlayground, families, exportShaper,
-// drawSpectrum). The page starts with `lite`, which leaves out the optimisation solver (87 KB
-// gzip); a state with a solved family (si, direct, sampled with an active bound) gets the
-// error kind "unavailable" from it, and the page switches to the module with the solver,
-// fetched then (loadSolver). A state in the URL that names si or direct starts with it.
-let api = lite;
-let solverLoad = null; // the promise of the module with the solver, once asked for
+// The page's wasm module (its glue's exports: renderPlayground, families, exportShaper,
+// drawSpectrum) leaves out the optimisation solver (87 KB gzip). The solved families (si,
+// direct, sampled with an active bound) are designed by a worker with the solver instead
+// ("Solved designs", below), fetched when the first one is needed; renderPlayground draws the
+// shapers it hands back.
+const api = lite;
 /** The families always designed by the solver (sampled only with bounds: the error tells). */
 const SOLVED_FAMILIES = new Set(['si', 'direct']);
 
 let state = clone(DEFAULT_STATE);
 let familyTable = [];
-let lastGood = null; // { state, result, left: the shapers it left out (indices) }
+let lastGood = null; // { state, result, left, waiting: the shapers it left out (indices) }
 
 // ---------- small DOM helpers (text only: user text never reaches innerHTML) ----------
 function el(tag, props = {}, ...children) {
@@ -402,26 +401,46 @@ function update() {
   Object.values(canvases).forEach(sizeCanvas);
   const st = { ...state, view: { ...state.view, pixelRatio: window.devicePixelRatio || 1 } };
   try {
-    const { result, kept, left } = render(st, canvases);
-    lastGood = { state: clone(state), result, left: left.map((l) => l.index) };
+    const { result, kept, left, waiting } = render(st, canvases);
+    lastGood = { state: clone(state), result, left: left.map((l) => l.index), waiting };
+    holdSince = null;
     showResults(result, state, kept);
     document.body.dataset.ready = 'true';
+    left.forEach((l) => showError(l.error));
+    waiting.forEach(showDesigning);
+    const lines = [];
     if (left.length) {
-      left.forEach((l) => showError(l.error));
-      const names = left.map((l) => l.index + 1).sort((a, b) => a - b);
-      $('general-error').textContent = names.length > 1
-        ? `Shapers ${names.slice(0, -1).join(', ')} and ${names.at(-1)} are left out of the charts and tables: they cannot be designed as they are (the messages are at the shapers).`
-        : `Shaper ${names[0]} is left out of the charts and tables: it cannot be designed as it is (the message is at the shaper).`;
+      const names = numbered(left.map((l) => l.index));
+      lines.push(left.length > 1
+        ? `Shapers ${names} are left out of the charts and tables: they cannot be designed as they are (the messages are at the shapers).`
+        : `Shaper ${names} is left out of the charts and tables: it cannot be designed as it is (the message is at the shaper).`);
     }
+    if (waiting.length) {
+      const names = numbered(waiting);
+      lines.push(`${waiting.length > 1 ? 'Shapers' : 'Shaper'} ${names} ${waiting.length > 1 ? 'are' : 'is'} left out until the optimisation solver has designed ${waiting.length > 1 ? 'them' : 'it'}: the page goes on meanwhile.`);
+    }
+    if (lines.length) $('general-error').textContent = lines.join(' ');
   } catch (error) {
-    if (error?.kind === 'unavailable' && api === lite) awaitSolver(error);
+    if (error?.kind === 'designing') error.waiting.forEach(showDesigning);
     else {
+      holdSince = null;
       showError(error);
       // Nothing good to keep on screen (a link or a reload): say why the charts are empty.
       if (!lastGood && !$('general-error').textContent) $('general-error').textContent = `Nothing can be drawn until this is fixed: ${error?.message ?? error}`;
     }
   }
   return performance.now() - t0;
+}
+
+/** "1", "1 and 3", "1, 2 and 4": shapers by their numbers on the page. */
+function numbered(indices) {
+  const n = indices.map((i) => i + 1).sort((a, b) => a - b);
+  return n.length > 1 ? `${n.slice(0, -1).join(', ')} and ${n.at(-1)}` : String(n[0]);
+}
+
+/** Says at shaper `k` that the optimisation solver is designing it. */
+function showDesigning(k) {
+  showError({ field: `shapers[${k}]`, message: 'Designing with the optimisation solver…' });
 }
 
 /** The compared shaper an error is about (its index in the state drawn), or -1. */
@@ -445,37 +464,191 @@ function renamed(error, j, k) {
  * colours, when nothing better is on screen: on the first frame (a link or a reload), and
  * while the last frame had left shapers out (edits elsewhere still draw; adding or removing a
  * shaper may move the one left out). Once every shaper drew, an error is thrown instead, so the
- * last good charts stay. Returns the result, the shapers drawn (indices) and those left out
- * with their errors.
+ * last good charts stay.
+ *
+ * A solved family's shaper is designed by the design worker and handed to renderPlayground
+ * (`designed`) once it is back. Until then it waits: with every shaper on screen, the frame is
+ * held (the last good charts stay, an error of kind "designing" is thrown) for up to HOLD_MS,
+ * so a quick design never makes the charts flicker; after that, or with nothing on screen yet,
+ * the others draw without it. Returns the result, the shapers drawn (indices), those left out
+ * with their errors and those waiting for their design.
  */
 function render(st, canvases) {
-  let kept = st.shapers.map((_, i) => i);
+  const requests = st.shapers.map((s) => ({ ...s, modes: st.modes }));
+  const keys = requests.map((r) => JSON.stringify(r));
+  const waiting = [];
   const left = [];
+  let kept = [];
+  st.shapers.forEach((s, i) => {
+    const known = designs.get(keys[i]);
+    if (known?.pending || (!known && SOLVED_FAMILIES.has(s.family))) waiting.push(i);
+    else kept.push(i);
+  });
+  const want = () => {
+    wantedKeys = new Set(waiting.map((i) => keys[i]));
+    waiting.forEach((i) => requestDesign(keys[i], requests[i]));
+    pump();
+  };
+  want();
   for (;;) {
-    const drawn = kept.length === st.shapers.length ? st : {
-      ...st,
-      shapers: kept.map((i) => st.shapers[i]),
-      view: { ...st.view, mapShaper: Math.max(0, kept.indexOf(st.view.mapShaper ?? 0)), seriesColors: kept },
-    };
-    try {
-      return { result: api.renderPlayground(drawn, canvases), kept, left };
-    } catch (error) {
-      const j = shaperOf(error);
-      const k = j < 0 ? -1 : kept[j];
-      const named = j < 0 ? error : renamed(error, j, k);
-      const mayLeave = k >= 0 && kept.length > 1 && error?.kind !== 'unavailable'
-        && (!lastGood || lastGood.left.length > 0);
-      if (!mayLeave) throw named;
-      left.push({ index: k, error: named });
-      kept = kept.filter((i) => i !== k);
+    let error;
+    let k = kept.find((i) => designs.get(keys[i])?.error);
+    if (k !== undefined) {
+      error = designerError(designs.get(keys[k]), k);
+    } else {
+      if (waiting.length && (!kept.length || holding())) throw Object.assign(new Error('designing'), { kind: 'designing', waiting });
+      const drawn = kept.length === st.shapers.length ? { ...st } : {
+        ...st,
+        shapers: kept.map((i) => st.shapers[i]),
+        view: { ...st.view, mapShaper: Math.max(0, kept.indexOf(st.view.mapShaper ?? 0)), seriesColors: kept },
+      };
+      drawn.designed = kept.map((i) => designs.get(keys[i])?.shaper ?? null);
+      try {
+        return { result: api.renderPlayground(drawn, canvases), kept, left, waiting };
+      } catch (e) {
+        const j = shaperOf(e);
+        k = j < 0 ? -1 : kept[j];
+        if (e?.kind === 'unavailable' && k >= 0) {
+          // A family the solver designs only with some settings (bounded sampled): it waits too.
+          waiting.push(k);
+          kept = kept.filter((i) => i !== k);
+          want();
+          continue;
+        }
+        error = j < 0 ? e : renamed(e, j, k);
+      }
+    }
+    const mayLeave = k >= 0 && kept.length > 1 && (!lastGood || lastGood.left.length > 0 || lastGood.waiting.length > 0);
+    if (!mayLeave) throw error;
+    left.push({ index: k, error });
+    kept = kept.filter((i) => i !== k);
+  }
+}
+
+// ---------- solved designs, off the main thread ----------
+// The design worker (web/design_worker.js) designs one shaper at a time with the designer
+// module (`design` and the optimisation solver), compiled here once, when the first solved
+// shaper is asked for. Its answers are kept by request (the shaper's spec with the modes, as
+// JSON) for as long as a state may come back to them (back/forward, undoing an edit). A design
+// that the state on screen no longer asks for is stopped, by ending the worker, once it has run
+// for STALE_MS (a quick one is left to finish: starting a worker costs more than it saves).
+const HOLD_MS = 250;
+const STALE_MS = 300;
+const KEPT_DESIGNS = 64;
+/** key → { pending: true, request } | { shaper } | { error, retry? } */
+const designs = new Map();
+let wantedKeys = new Set(); // the keys the last frame waited for
+let designerModule = null; // the promise of the compiled designer module
+let designer = null; // { worker, ready, key: the design running or null, since }
+let designId = 0;
+let staleTimer = 0;
+let holdSince = null; // when the frame on screen began to be held for a design
+let holdTimer = 0;
+
+/** Whether to keep the last good charts while a design is on its way (see render). */
+function holding() {
+  if (!lastGood || lastGood.waiting.length) return false;
+  holdSince ??= performance.now();
+  const left = HOLD_MS - (performance.now() - holdSince);
+  if (left <= 0) return false;
+  clearTimeout(holdTimer);
+  holdTimer = setTimeout(schedule, left);
+  return true;
+}
+
+/** The design worker's error for shaper `k`, named to it (`shapers[k].…`). */
+function designerError({ error }, k) {
+  const at = `shapers[${k}]`;
+  const f = typeof error.field === 'string' ? error.field : '';
+  const field = !f ? at : f.startsWith('[') ? at + f : `${at}.${f}`;
+  const message = f && error.message.startsWith(f) ? field + error.message.slice(f.length) : `${at}: ${error.message}`;
+  return { kind: error.kind, field, message };
+}
+
+/** After an edit, a design whose solver could not be loaded is asked for again. */
+function forgetFailedLoads() {
+  for (const [k, v] of designs) if (v.retry) designs.delete(k);
+}
+
+function requestDesign(key, request) {
+  if (designs.has(key)) return;
+  designs.set(key, { pending: true, request });
+  // Keep the cache bounded: drop the oldest answers first.
+  if (designs.size > KEPT_DESIGNS) {
+    for (const [k, v] of designs) {
+      if (designs.size <= KEPT_DESIGNS) break;
+      if (!v.pending) designs.delete(k);
     }
   }
+}
+
+/** Starts the next wanted design if the worker is free; stops one nobody wants any more. */
+function pump() {
+  // Requests no frame waits for any more are forgotten (asked again if their state comes back).
+  for (const [k, v] of designs) if (v.pending && !wantedKeys.has(k) && designer?.key !== k) designs.delete(k);
+  if (designer?.key && !wantedKeys.has(designer.key)) {
+    const age = performance.now() - designer.since;
+    if (age >= STALE_MS) {
+      designer.worker.terminate();
+      designs.delete(designer.key);
+      designer = null;
+    } else {
+      clearTimeout(staleTimer);
+      staleTimer = setTimeout(pump, STALE_MS - age + 1);
+    }
+  }
+  const next = [...wantedKeys].find((k) => designs.get(k)?.pending && designer?.key !== k);
+  if (next && !designer?.key) runDesign(next);
+  if ([...wantedKeys].some((k) => designs.get(k)?.pending)) document.body.dataset.fetching = 'designs'; // for the tests
+  else delete document.body.dataset.fetching;
+}
+
+function runDesign(key) {
+  designerModule ??= compileModule('designer_bg.wasm');
+  if (!designer) {
+    const worker = new Worker(new URL('./design_worker.js', import.meta.url), { type: 'module' });
+    const ready = designerModule.then((module) => {
+      try {
+        worker.postMessage({ module });
+      } catch {
+        worker.postMessage({ module: null }); // not cloneable here: the worker fetches it
+      }
+    });
+    designer = { worker, ready, key: null, since: 0 };
+    const mine = designer;
+    worker.addEventListener('message', ({ data }) => answered(mine, data));
+    worker.addEventListener('error', (e) => answered(mine, { id: mine.id, error: { kind: 'load', message: `The design worker failed (${e.message ?? e})` } }));
+  }
+  const d = designer;
+  d.key = key;
+  d.id = ++designId;
+  d.since = performance.now();
+  const { request } = designs.get(key);
+  d.ready.then(() => d.worker.postMessage({ id: d.id, request }), (e) => {
+    designerModule = null; // the next request tries again
+    answered(d, { id: d.id, error: { kind: 'load', message: `The optimisation solver could not be loaded (${e?.message ?? e})` } });
+  });
+}
+
+/** The worker's answer: kept, the next design started and the page redrawn with it. */
+function answered(d, { id, shaper, error }) {
+  if (d !== designer || id !== d.id || !d.key) return; // from a worker since ended, or late
+  const failedToLoad = error?.kind === 'load';
+  designs.set(d.key, shaper ? { shaper } : { error, retry: failedToLoad });
+  d.key = null;
+  if (failedToLoad) {
+    d.worker.terminate();
+    designer = null;
+  }
+  pump();
+  schedule();
 }
 
 let frame = 0;
 let editing = false;
 /** Schedules one update for the next frame and records the state in the URL. */
 function changed(commit = false) {
+  forgetFailedLoads();
   const hash = toHash(state);
   if (hash !== location.hash) {
     // One history entry per editing gesture: push at its start, replace while it goes on.
@@ -492,6 +665,7 @@ function schedule() {
 }
 
 function loadState(next, { push = true } = {}) {
+  forgetFailedLoads();
   state = next;
   rebuild();
   if (push) changed(true);
@@ -516,33 +690,10 @@ function fromLocation({ startup = false } = {}) {
 }
 
 /**
- * The state needs the solver: keeps the last good charts, says so at the shaper, fetches the
- * module with the solver once and redraws with it (or says why it could not be fetched).
- */
-function awaitSolver(error) {
-  showError({ field: error.field, message: 'Fetching the optimisation solver this shaper is designed with…' });
-  document.body.dataset.fetching = 'solver'; // for the tests: wait until it is gone
-  loadSolver().then(schedule, (e) => {
-    solverLoad = null; // the next edit tries again
-    showError({ field: error.field, message: `The optimisation solver could not be loaded (${e?.message ?? e}): ${error.message}` });
-  }).finally(() => delete document.body.dataset.fetching);
-}
-
-/** Fetches, compiles and instantiates the module with the solver, once; then uses it. */
-function loadSolver() {
-  solverLoad ??= (async () => {
-    const glue = await import('../pkg/page/playground_solver.js');
-    await glue.default({ module_or_path: await compileModule('playground_solver_bg.wasm') });
-    api = glue;
-  })();
-  return solverLoad;
-}
-
-/**
- * A wasm module of the page, compiled. The first one is instantiated here and (without the
- * solver) handed to the measured-data worker, which ranks shapers with it without fetching or
- * compiling it again. This file runs as the bundle pkg/page/main.js (scripts/bundle.sh),
- * beside the .wasm files, as the glue inside it does.
+ * A wasm module of the page, compiled. The page's is instantiated here and handed to the
+ * measured-data worker, which ranks shapers with it without fetching or compiling it again; the
+ * designer module is handed to the design worker. This file runs as the bundle
+ * pkg/page/main.js (scripts/bundle.sh), beside the .wasm files, as the glue inside it does.
  */
 async function compileModule(file) {
   const response = await fetch(new URL(file, import.meta.url));
@@ -556,18 +707,8 @@ async function compileModule(file) {
 }
 
 async function main() {
-  // A link to a state with a solved family starts with the solver's module (one module fetched,
-  // not both); otherwise the smaller one, which the measured-data worker also uses.
-  // If that module cannot be fetched, the page starts without it and says so at the shaper.
-  const linked = fromHash(location.hash).state;
-  let wasmModule = null;
-  if (linked?.shapers.some((s) => SOLVED_FAMILIES.has(s.family))) {
-    await loadSolver().catch(() => { solverLoad = null; });
-  }
-  if (api === lite) {
-    wasmModule = await compileModule('playground_bg.wasm');
-    await lite.default({ module_or_path: wasmModule });
-  }
+  const wasmModule = await compileModule('playground_bg.wasm');
+  await lite.default({ module_or_path: wasmModule });
   familyTable = api.families();
   $('preset').append(...PRESETS.map((p) => el('option', { value: p.id }, p.title)));
   $('preset').addEventListener('change', () => {
@@ -642,7 +783,7 @@ async function main() {
   fromLocation({ startup: true });
   // Measured data: identified modes replace the editor's modes with one click.
   setupMeasure({
-    wasmModule, // null when the page started with the solver's module: the worker fetches its own
+    wasmModule,
     drawSpectrum: (...args) => api.drawSpectrum(...args),
     acceptModes(modes) { state.modes = modes.slice(0, MAX_MODES); rebuild(); changed(true); },
   });

@@ -157,22 +157,24 @@ function assertSlsqp(rows) {
   });
 }
 
-test('a solved family fetches the module with the solver, once, and designs what the core designs', async () => {
+test('a solved family is designed by the design worker, whose module is fetched once, as the core designs it', async () => {
   const { page, problems, fetched } = await env.page();
-  // The default page (ZVD) loads the module without the solver only.
+  // The default page (ZVD) loads the page's module only.
   assert.ok(fetched.includes('/pkg/page/playground_bg.wasm'), fetched.join(' '));
-  assert.ok(!fetched.some((f) => f.startsWith('/pkg/page/playground_solver')), fetched.join(' '));
+  assert.ok(!fetched.some((f) => f.startsWith('/pkg/page/design')), fetched.join(' '));
   const before = await canvasInfo(page, 'impulses-chart');
   await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, SI_STATE);
   await settle(page);
-  assert.equal(fetched.filter((f) => f === '/pkg/page/playground_solver_bg.wasm').length, 1, fetched.join(' '));
+  assert.equal(fetched.filter((f) => f === '/pkg/page/designer_bg.wasm').length, 1, fetched.join(' '));
+  assert.equal(fetched.filter((f) => f === '/pkg/page/playground_bg.wasm').length, 1, fetched.join(' '));
   assertSlsqp(await impulseRows(page, 0));
   assert.equal((await impulseRows(page, 1)).length, 3);
   const errors = await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
   assert.deepEqual(errors, []);
+  assert.equal(await page.textContent('#general-error'), '');
   const after = await canvasInfo(page, 'impulses-chart');
   assert.ok(after.ink > 1000 && after.hash !== before.hash, 'the SI shaper is drawn');
-  // Later edits use the module already there: nothing is fetched again.
+  // Later edits use the worker already there: nothing is fetched again.
   const count = fetched.length;
   await type(page, 'mode-0-damping', 0.004);
   await settle(page);
@@ -182,42 +184,73 @@ test('a solved family fetches the module with the solver, once, and designs what
   await page.close();
 });
 
-test('a link with a solved family starts with the module with the solver, not both', async () => {
+test('a link with a solved family draws with the page\'s module and adds the solved shaper when it is designed', async () => {
   const { page, problems, fetched } = await env.page({ hash: `#state=${encodeURIComponent(JSON.stringify(SI_STATE))}` });
-  assert.ok(fetched.includes('/pkg/page/playground_solver_bg.wasm'), fetched.join(' '));
-  assert.ok(!fetched.includes('/pkg/page/playground_bg.wasm'), fetched.join(' '));
+  await settle(page);
+  assert.ok(fetched.includes('/pkg/page/playground_bg.wasm'), fetched.join(' '));
+  assert.ok(fetched.includes('/pkg/page/designer_bg.wasm'), fetched.join(' '));
   assertSlsqp(await impulseRows(page, 0));
+  assert.equal(await page.textContent('#general-error'), '');
   // A 0.5 Hz shaper smooths more than Klipper's 0.12 mm target at any acceleration: Klipper's
   // max accel is 0, said in words.
   assert.deepEqual((await summary(page))['Klipper max accel, smoothing ≤ 0.12 mm (mm/s²)'], ['0 (none keeps smoothing ≤ 0.12 mm)', '0 (none keeps smoothing ≤ 0.12 mm)']);
   await page.screenshot({ path: `${SCREENSHOTS}si-link-1280x800.png`, fullPage: true });
-  // Back to a state without a solved family: the module with the solver goes on serving it.
+  // Back to a state without a solved family.
   await page.evaluate(() => { location.hash = `#state=${encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: 2, damping: 0.05 }], shapers: [{ family: 'zvd' }] }))}`; });
   await settle(page);
   assert.equal((await impulseRows(page, 0)).length, 3);
-  assert.ok(!fetched.includes('/pkg/page/playground_bg.wasm'), fetched.join(' '));
   assert.deepEqual(problems, []);
   await page.close();
 });
 
-test('if the solver\'s module cannot be fetched, the shaper says so, the last good result stays, and the next edit tries again', async () => {
+test('if the designer\'s module cannot be fetched, the shaper says so, the last good result stays, and the next edit tries again', async () => {
   const { page, problems } = await env.page();
   const before = { imp: await canvasInfo(page, 'impulses-chart'), rows: await impulseRows(page) };
-  await page.route('**/playground_solver*', (r) => r.abort());
+  await page.route('**/designer*', (r) => r.abort());
   await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, SI_STATE);
   await settle(page);
   const message = await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
   assert.equal(message.length, 1, JSON.stringify(message));
-  assert.match(message[0], /^The optimisation solver could not be loaded \(.*\): shapers\[0\]: this shaper is designed by the optimisation solver/);
+  assert.match(message[0], /^shapers\[0\]: The optimisation solver could not be loaded \(.+\)$/);
   assert.equal((await canvasInfo(page, 'impulses-chart')).hash, before.imp.hash, 'the last good chart stays');
   assert.deepEqual(await impulseRows(page), before.rows, 'the last good numbers stay');
-  await page.unroute('**/playground_solver*');
+  await page.unroute('**/designer*');
   await type(page, 'mode-0-damping', 0.003);
   await settle(page);
   assert.deepEqual(await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean)), []);
   assert.equal((await impulseRows(page, 0)).length, 4);
   // The aborted requests are the only console errors.
-  assert.deepEqual(problems.filter((p) => !/Failed to load resource|playground_solver/.test(p)), []);
+  assert.deepEqual(problems.filter((p) => !/Failed to load resource|designer/.test(p)), []);
+  await page.close();
+});
+
+test('a slow solved design never freezes the page, and one nobody wants any more is stopped', async () => {
+  const { page, problems } = await env.page();
+  // SI at I = 0.3 over six modes: about two minutes of solving (README, "What takes longer
+  // than a frame"), with a ZVD beside it.
+  const slow = {
+    modes: [1.2, 3.4, 7.9, 13, 21, 34].map((f) => ({ frequencyHz: f, damping: 0.02 })),
+    shapers: [{ family: 'si', vtol: 0.05, insensitivity: 0.3 }, { family: 'zvd' }],
+  };
+  await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, slow);
+  // The ZVD draws without the SI, which says it is being designed.
+  await page.waitForFunction(() => /^Shaper 1 is left out until the optimisation solver has designed it/.test(document.getElementById('general-error').textContent), null, { timeout: 20000 });
+  assert.equal(await page.getAttribute('body', 'data-fetching'), 'designs');
+  const messages = await page.$$eval('#controls .error', (e) => e.map((x) => x.textContent).filter(Boolean));
+  assert.deepEqual(messages, ['Designing with the optimisation solver…']);
+  assert.equal((await impulseRows(page, 0)).length, 729, 'the ZVD over six modes is shown');
+  // The page still answers edits meanwhile: a mismatch edit is drawn before the design is back.
+  assert.match(await page.textContent('#simulation-note'), /model × 1;/);
+  await type(page, 'mismatch', 1.3);
+  await page.waitForFunction(() => /model × 1\.3;/.test(document.getElementById('simulation-note').textContent), null, { timeout: 20000 });
+  assert.equal(await page.getAttribute('body', 'data-fetching'), 'designs', 'the design is still running');
+  // A state that no longer needs it: the running design is stopped and the new one runs at
+  // once (waiting for the old one would take minutes; settle gives up after 20 s).
+  await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, SI_STATE);
+  await settle(page);
+  assertSlsqp(await impulseRows(page, 0));
+  assert.equal(await page.textContent('#general-error'), '');
+  assert.deepEqual(problems, []);
   await page.close();
 });
 
