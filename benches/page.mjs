@@ -2,10 +2,11 @@
 // recompute everything and redraw every chart (impulses, V(f), V(ζ), the map, the simulated
 // response, the command, its spectrum, robustness), as one input event does — with 3 modes and
 // 4 compared shapers, and report p50 / p95 / max in ms, plus the shipped size (gzip -9 of every
-// file the browser fetched: on the first load; then for choosing a solved family, which
-// fetches the module with the optimisation solver; then for opening a recording, which fetches
-// the measured-data worker and its module; and on the first load of a link to a state with a
-// solved family, which fetches the module with the solver instead of the one without).
+// file the browser fetched: on the first load; then for opening a recording, which fetches
+// the measured-data worker and its module; then for choosing a solved family, which starts the
+// design worker and fetches its module with the optimisation solver; and for a link to a state
+// with a solved family: what it is drawn with, the same first load, and the design worker's
+// files, fetched as it starts, which add the solved shaper when they have designed it).
 // Two kinds of edit: a mode's frequency (every shaper redesigned and every chart recomputed;
 // the robustness background is cached per damping ratio and Vtol, so a frequency edit only
 // rescales it) and the mismatch r (the designs stay; the simulation and its charts change).
@@ -83,7 +84,7 @@ try {
     || document.getElementById('measure-error').textContent !== '');
   await page.waitForLoadState('networkidle');
   const measured = [...new Set(fetched.slice(loaded))];
-  // Choose a solved family (SI over I = 0.3 at Vtol 5 %): the page fetches the solver's module.
+  // Choose a solved family (SI over I = 0.3 at Vtol 5 %): the page starts the design worker.
   const beforeSolver = fetched.length;
   await page.evaluate(() => { const pg = window.__playground; pg.state.shapers[0] = { family: 'si', vtol: 0.05, insensitivity: 0.3 }; pg.update(); });
   await page.waitForFunction(() => !document.body.dataset.fetching);
@@ -98,8 +99,11 @@ try {
   await linked.waitForLoadState('networkidle');
   report('shipped on the first load', firstLoad, '(budget: 300 KB)');
   report('fetched when a recording is opened', measured, '(the measured-data worker)');
-  report('fetched when a solved family (SI) is chosen', solver, '(the module with the solver)');
-  report('shipped on the first load of a link with a solved family', [...new Set(linkFetched)], '(the module with the solver instead)');
+  report('fetched when a solved family (SI) is chosen', solver, '(the design worker and its module with the solver)');
+  const designer = (f) => f.startsWith('/pkg/page/design');
+  const link = [...new Set(linkFetched)];
+  report('shipped on the first load of a link with a solved family', link.filter((f) => !designer(f)), '(the page is drawn, the solved shaper left out until designed)');
+  report('  then fetched for its solved shaper', link.filter(designer), '(the design worker and its module)');
 } finally {
   await browser.close();
   server.close();

@@ -224,6 +224,33 @@ test('if the designer\'s module cannot be fetched, the shaper says so, the last 
   await page.close();
 });
 
+test('a sampled shaper with an amplitude bound, which only the solver designs, goes to the design worker too', async () => {
+  const { page, problems, fetched } = await env.page();
+  const kamel = (bound) => ({
+    modes: [{ frequencyHz: 30 / (2 * Math.PI), damping: 0.02 }],
+    shapers: [{ family: 'sampled', periodS: 0.012, impulses: 36, delaySamples: 17, weight: 0.1, derivatives: 1, plantGain: 8e-4, objective: 'controlError', ...bound }, { family: 'zvd' }],
+  });
+  // Kamel, Lange & Hirzinger's control-error shaper without bounds (closed form, the page's
+  // own module) has negative amplitudes ...
+  await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, kamel({}));
+  await settle(page);
+  const free = await impulseRows(page, 0);
+  assert.equal(free.length, 36);
+  assert.ok(free.some(([, a]) => a < -1e-3), JSON.stringify(free));
+  assert.ok(!fetched.includes('/pkg/page/designer_bg.wasm'), fetched.join(' '));
+  // ... with A ≥ 0 (eq. 7) the page's module answers "unavailable" and the worker designs it.
+  await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, kamel({ amplitudeMin: 0 }));
+  await settle(page);
+  assert.ok(fetched.includes('/pkg/page/designer_bg.wasm'), fetched.join(' '));
+  const bounded = await impulseRows(page, 0);
+  assert.ok(bounded.length > 0 && bounded.length <= 36, JSON.stringify(bounded));
+  assert.ok(bounded.every(([, a]) => a > -1e-6), JSON.stringify(bounded));
+  assert.ok(Math.abs(bounded.reduce((sum, [, a]) => sum + a, 0) - 1) < 1e-4, 'unity gain');
+  assert.deepEqual(await page.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean)), []);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('a slow solved design never freezes the page, and one nobody wants any more is stopped', async () => {
   const { page, problems } = await env.page();
   // SI at I = 0.3 over six modes: about two minutes of solving (README, "What takes longer
