@@ -404,6 +404,7 @@ function update() {
     const { result, kept, left, waiting } = render(st, canvases);
     lastGood = { state: clone(state), result, left: left.map((l) => l.index), waiting };
     holdSince = null;
+    clearTimeout(holdTimer);
     showResults(result, state, kept);
     document.body.dataset.ready = 'true';
     left.forEach((l) => showError(l.error));

@@ -65,8 +65,8 @@ export async function canvasInfo(page, id) {
 
 /**
  * Waits until the page has drawn what it was asked to: two animation frames (an edit's update
- * runs in the next one), and, if that update had to fetch the module with the solver, until it
- * arrived and drew.
+ * runs in the next one), and, if that update sent a solved shaper to the design worker, until
+ * its design came back and was drawn.
  */
 export async function settle(page) {
   const frames = () => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
