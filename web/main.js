@@ -405,6 +405,7 @@ function update() {
     lastGood = { state: clone(state), result, left: left.map((l) => l.index), waiting };
     holdSince = null;
     clearTimeout(holdTimer);
+    if (!waiting.length) dragging = false;
     showResults(result, state, kept);
     document.body.dataset.ready = 'true';
     left.forEach((l) => showError(l.error));
@@ -476,15 +477,26 @@ function renamed(error, j, k) {
  */
 function render(st, canvases) {
   const requests = st.shapers.map((s) => ({ ...s, modes: st.modes }));
-  const keys = requests.map((r) => JSON.stringify(r));
+  const keys = requests.map(designKey);
   const waiting = [];
   const left = [];
   let kept = [];
+  // While a drag goes on (see `dragging`), a design that is back waits for a pause.
+  const sinceEdit = performance.now() - lastEdit;
+  const quiet = !dragging || sinceEdit >= QUIET_MS;
+  awaitingQuiet = false;
   st.shapers.forEach((s, i) => {
     const known = designs.get(keys[i]);
-    if (known?.pending || (!known && SOLVED_FAMILIES.has(s.family))) waiting.push(i);
+    if (known?.shaper && !quiet) {
+      waiting.push(i);
+      awaitingQuiet = true;
+    } else if (known?.pending || (!known && SOLVED_FAMILIES.has(s.family))) waiting.push(i);
     else kept.push(i);
   });
+  if (awaitingQuiet) {
+    clearTimeout(quietTimer);
+    quietTimer = setTimeout(schedule, QUIET_MS - sinceEdit + 1);
+  }
   const want = () => {
     wantedKeys = new Set(waiting.map((i) => keys[i]));
     waiting.forEach((i) => requestDesign(keys[i], requests[i]));
@@ -535,6 +547,7 @@ function render(st, canvases) {
 // for STALE_MS (a quick one is left to finish: starting a worker costs more than it saves).
 const HOLD_MS = 250;
 const STALE_MS = 300;
+const QUIET_MS = 150;
 const KEPT_DESIGNS = 64;
 /** key → { pending: true, request } | { shaper } | { error, retry? } */
 const designs = new Map();
@@ -543,8 +556,18 @@ let designerModule = null; // the promise of the compiled designer module
 let designer = null; // { worker, ready, key: the design running or null, since }
 let designId = 0;
 let staleTimer = 0;
-let holdSince = null; // when the frame on screen began to be held for a design
+let holdSince = null; // when the frame on screen began to be held for a design (-Infinity: stop)
 let holdTimer = 0;
+// A drag: a design came back for a state the page had already left. Until a frame draws every
+// shaper again, solved shapers stay out while edits keep coming (QUIET_MS apart at most), so
+// they do not blink in and out of the charts whenever a design happens to keep up.
+let dragging = false;
+let lastEdit = -Infinity; // when the state was last edited (performance.now())
+let awaitingQuiet = false; // the last frame left a designed shaper out for the drag
+let quietTimer = 0;
+
+/** A design request's key in `designs`: `design`'s spec ({ …shaper, modes }) as JSON. */
+const designKey = (request) => JSON.stringify(request);
 
 /** Whether to keep the last good charts while a design is on its way (see render). */
 function holding() {
@@ -600,7 +623,7 @@ function pump() {
   }
   const next = [...wantedKeys].find((k) => designs.get(k)?.pending && designer?.key !== k);
   if (next && !designer?.key) runDesign(next);
-  if ([...wantedKeys].some((k) => designs.get(k)?.pending)) document.body.dataset.fetching = 'designs'; // for the tests
+  if (awaitingQuiet || [...wantedKeys].some((k) => designs.get(k)?.pending)) document.body.dataset.fetching = 'designs'; // for the tests
   else delete document.body.dataset.fetching;
 }
 
@@ -634,6 +657,14 @@ function runDesign(key) {
 /** The worker's answer: kept, the next design started and the page redrawn with it. */
 function answered(d, { id, shaper, error }) {
   if (d !== designer || id !== d.id || !d.key) return; // from a worker since ended, or late
+  // A design back for a state already left (a slider being dragged, the next step not drawn
+  // yet): holding the charts for each next one would make the whole page follow the drag at
+  // the designs' pace, so the others draw now, without the solved shaper.
+  const current = state.shapers.some((s) => designKey({ ...s, modes: state.modes }) === d.key);
+  if (!current) {
+    dragging = true;
+    if (holdSince !== null) holdSince = -Infinity;
+  }
   const failedToLoad = error?.kind === 'load';
   designs.set(d.key, shaper ? { shaper } : { error, retry: failedToLoad });
   d.key = null;
@@ -650,6 +681,7 @@ let editing = false;
 /** Schedules one update for the next frame and records the state in the URL. */
 function changed(commit = false) {
   forgetFailedLoads();
+  lastEdit = performance.now();
   const hash = toHash(state);
   if (hash !== location.hash) {
     // One history entry per editing gesture: push at its start, replace while it goes on.

@@ -4,6 +4,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { openBrowser, canvasInfo, type, settle, SCREENSHOTS } from './browser.mjs';
+import { PRESETS } from '../../web/state.js';
 
 let env;
 before(async () => { env = await openBrowser(); });
@@ -221,6 +222,47 @@ test('if the designer\'s module cannot be fetched, the shaper says so, the last 
   assert.equal((await impulseRows(page, 0)).length, 4);
   // The aborted requests are the only console errors.
   assert.deepEqual(problems.filter((p) => !/Failed to load resource|designer/.test(p)), []);
+  await page.close();
+});
+
+test('dragging a mode keeps the other shapers live and ends with the solved shaper designed where it stopped', async () => {
+  const pelaez = PRESETS.find((p) => p.id === 'pelaez').state;
+  const { page, problems } = await env.page({ hash: `#state=${encodeURIComponent(JSON.stringify(pelaez))}` });
+  await settle(page);
+  const before = await impulseRows(page, 0);
+  assert.ok(before.length >= 3, JSON.stringify(before));
+  // 40 steps of the first mode's frequency, one per frame, as a slider drag sends them; the
+  // ZVD's impulse table (shaper 2, designed by the page's module) is read after every step.
+  const zvdChanges = await page.evaluate(async () => {
+    const input = document.getElementById('mode-0-frequency');
+    const rows = () => [...document.querySelectorAll('table.impulses')].find((t) => t.caption.textContent === 'ZVD').tBodies[0].textContent;
+    let last = rows();
+    let changes = 0;
+    for (let i = 1; i <= 40; i++) {
+      input.value = String(0.5 + i * 0.002);
+      input.dispatchEvent(new Event('input', { bubbles: true }));
+      await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+      if (rows() !== last) changes++;
+      last = rows();
+    }
+    return changes;
+  });
+  assert.ok(zvdChanges >= 30, `the ZVD followed the drag: ${zvdChanges} of 40 steps drawn`);
+  await settle(page);
+  assert.equal(await page.textContent('#general-error'), '');
+  const shown = await impulseRows(page, 0);
+  // The same state opened afresh: the SI shown after the drag is the one for 0.58 Hz.
+  const state = await page.evaluate(() => window.__playground.state);
+  assert.equal(state.modes[0].frequencyHz, 0.58);
+  const fresh = await env.page({ hash: `#state=${encodeURIComponent(JSON.stringify(state))}` });
+  await settle(fresh.page);
+  assert.deepEqual(shown, await impulseRows(fresh.page, 0));
+  // One mode: the SI's times scale as 1/f (its band is relative to the mode).
+  const scaled = before.at(-1)[0] * 0.5 / 0.58;
+  assert.ok(Math.abs(shown.at(-1)[0] / scaled - 1) < 0.01, `the SI is the one for 0.58 Hz: ${shown.at(-1)[0]} vs ${scaled}`);
+  assert.deepEqual(problems, []);
+  assert.deepEqual(fresh.problems, []);
+  await fresh.page.close();
   await page.close();
 });
 
