@@ -266,6 +266,26 @@ test('dragging a mode keeps the other shapers live and ends with the solved shap
   await page.close();
 });
 
+test('a solved design that fails says why at its shaper; the others draw', async () => {
+  // No SI of at most 0.5 s exists for a 0.5 Hz mode (a period is 2 s).
+  const st = { modes: [{ frequencyHz: 0.5, damping: 0.002 }], shapers: [{ family: 'si', vtol: 0.05, insensitivity: 0.7, maxDuration: 0.5 }, { family: 'zvd' }] };
+  const { page, problems } = await env.page({ hash: `#state=${encodeURIComponent(JSON.stringify(st))}` });
+  await settle(page);
+  const messages = await page.$$eval('#controls .error', (e) => e.map((x) => x.textContent).filter(Boolean));
+  assert.equal(messages.length, 1, JSON.stringify(messages));
+  assert.match(messages[0], /^shapers\[0\]: infeasible: no shaper of at most maxDuration = 0\.5 s meets the constraints/);
+  assert.match(await page.textContent('#general-error'), /^Shaper 1 is left out of the charts and tables: it cannot be designed as it is/);
+  const tables = await page.$$eval('table.impulses caption', (c) => c.map((x) => x.textContent));
+  assert.deepEqual(tables, ['ZVD']);
+  // Without the limit it is designed and joins the others.
+  await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, { ...st, shapers: [{ family: 'si', vtol: 0.05, insensitivity: 0.7 }, { family: 'zvd' }] });
+  await settle(page);
+  assert.equal(await page.textContent('#general-error'), '');
+  assert.equal((await page.$$eval('table.impulses', (t) => t.length)), 2);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('a sampled shaper with an amplitude bound, which only the solver designs, goes to the design worker too', async () => {
   const { page, problems, fetched } = await env.page();
   const kamel = (bound) => ({
