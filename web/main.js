@@ -666,9 +666,12 @@ function answered(d, { id, shaper, error }) {
     if (holdSince !== null) holdSince = -Infinity;
   }
   const failedToLoad = error?.kind === 'load';
-  designs.set(d.key, shaper ? { shaper } : { error, retry: failedToLoad });
+  // An error without a kind is a trap (the core's errors all have one): the module may be
+  // left in a bad state, so the next design starts a fresh worker.
+  const trapped = error && !error.kind;
+  designs.set(d.key, shaper ? { shaper } : { error, retry: failedToLoad || trapped });
   d.key = null;
-  if (failedToLoad) {
+  if (failedToLoad || trapped) {
     d.worker.terminate();
     designer = null;
   }
