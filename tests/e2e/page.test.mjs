@@ -286,6 +286,26 @@ test('a solved design that fails says why at its shaper; the others draw', async
   await page.close();
 });
 
+test('a design that traps ends the design worker; after the next edit a fresh one designs it', async () => {
+  const { page, problems } = await env.page();
+  // A stand-in worker whose design traps, as a panicking module would (an error without a kind).
+  await page.route('**/design_worker.js', (r) => r.fulfill({
+    contentType: 'text/javascript',
+    body: "self.onmessage = ({ data }) => { if ('id' in data) postMessage({ id: data.id, error: { message: 'RuntimeError: unreachable' } }); };",
+  }));
+  await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, SI_STATE);
+  await settle(page);
+  const messages = await page.$$eval('#controls .error', (e) => e.map((x) => x.textContent).filter(Boolean));
+  assert.deepEqual(messages, ['shapers[0]: RuntimeError: unreachable']);
+  await page.unroute('**/design_worker.js');
+  await type(page, 'mode-0-damping', 0.004);
+  await settle(page);
+  assert.deepEqual(await page.$$eval('#controls .error', (e) => e.map((x) => x.textContent).filter(Boolean)), []);
+  assert.equal((await impulseRows(page, 0)).length, 4);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('a sampled shaper with an amplitude bound, which only the solver designs, goes to the design worker too', async () => {
   const { page, problems, fetched } = await env.page();
   const kamel = (bound) => ({
