@@ -401,7 +401,7 @@ function update() {
   Object.values(canvases).forEach(sizeCanvas);
   const st = { ...state, view: { ...state.view, pixelRatio: window.devicePixelRatio || 1 } };
   try {
-    const { result, kept, left, waiting } = render(st, canvases);
+    const { result, kept, left, waiting, waitingKeys } = render(st, canvases);
     lastGood = { state: clone(state), result, left: left.map((l) => l.index), waiting };
     holdSince = null;
     clearTimeout(holdTimer);
@@ -409,7 +409,7 @@ function update() {
     showResults(result, state, kept);
     document.body.dataset.ready = 'true';
     left.forEach((l) => showError(l.error));
-    waiting.forEach(showDesigning);
+    showDesigning(waiting, waitingKeys);
     const lines = [];
     if (left.length) {
       const names = numbered(left.map((l) => l.index));
@@ -423,8 +423,9 @@ function update() {
     }
     if (lines.length) $('general-error').textContent = lines.join(' ');
   } catch (error) {
-    if (error?.kind === 'designing') error.waiting.forEach(showDesigning);
+    if (error?.kind === 'designing') showDesigning(error.waiting, error.keys);
     else {
+      showDesigning([], []);
       holdSince = null;
       showError(error);
       // Nothing good to keep on screen (a link or a reload): say why the charts are empty.
@@ -440,9 +441,21 @@ function numbered(indices) {
   return n.length > 1 ? `${n.slice(0, -1).join(', ')} and ${n.at(-1)}` : String(n[0]);
 }
 
-/** Says at shaper `k` that the optimisation solver is designing it. */
-function showDesigning(k) {
-  showError({ field: `shapers[${k}]`, message: 'Designing with the optimisation solver…' });
+/**
+ * Says at each waiting shaper (`waiting[i]`, its design `keys[i]`) that the optimisation
+ * solver is designing it, with the seconds it has waited once that is a second or more, kept
+ * up to date every second while one waits.
+ */
+let designingTicker = 0;
+function showDesigning(waiting, keys) {
+  const show = () => waiting.forEach((k, i) => {
+    const since = designs.get(keys[i])?.since;
+    const seconds = since === undefined ? 0 : Math.floor((performance.now() - since) / 1000);
+    showError({ field: `shapers[${k}]`, message: `Designing with the optimisation solver…${seconds >= 1 ? ` (${seconds} s)` : ''}` });
+  });
+  show();
+  clearInterval(designingTicker);
+  if (waiting.length) designingTicker = setInterval(show, 1000);
 }
 
 /** The compared shaper an error is about (its index in the state drawn), or -1. */
@@ -509,7 +522,7 @@ function render(st, canvases) {
     if (k !== undefined) {
       error = designerError(designs.get(keys[k]), k);
     } else {
-      if (waiting.length && (!kept.length || holding())) throw Object.assign(new Error('designing'), { kind: 'designing', waiting });
+      if (waiting.length && (!kept.length || holding())) throw Object.assign(new Error('designing'), { kind: 'designing', waiting, keys: waiting.map((i) => keys[i]) });
       const drawn = kept.length === st.shapers.length ? { ...st } : {
         ...st,
         shapers: kept.map((i) => st.shapers[i]),
@@ -517,7 +530,7 @@ function render(st, canvases) {
       };
       drawn.designed = kept.map((i) => designs.get(keys[i])?.shaper ?? null);
       try {
-        return { result: api.renderPlayground(drawn, canvases), kept, left, waiting };
+        return { result: api.renderPlayground(drawn, canvases), kept, left, waiting, waitingKeys: waiting.map((i) => keys[i]) };
       } catch (e) {
         const j = shaperOf(e);
         k = j < 0 ? -1 : kept[j];
@@ -549,7 +562,7 @@ const HOLD_MS = 250;
 const STALE_MS = 300;
 const QUIET_MS = 150;
 const KEPT_DESIGNS = 64;
-/** key → { pending: true, request } | { shaper } | { error, retry? } */
+/** key → { pending: true, request, since } | { shaper } | { error, retry? } */
 const designs = new Map();
 let wantedKeys = new Set(); // the keys the last frame waited for
 let designerModule = null; // the promise of the compiled designer module
@@ -596,7 +609,7 @@ function forgetFailedLoads() {
 
 function requestDesign(key, request) {
   if (designs.has(key)) return;
-  designs.set(key, { pending: true, request });
+  designs.set(key, { pending: true, request, since: performance.now() });
   // Keep the cache bounded: drop the oldest answers first.
   if (designs.size > KEPT_DESIGNS) {
     for (const [k, v] of designs) {
