@@ -239,8 +239,7 @@ struct PlaygroundState {
     /// it here). The page designs the solved families in a worker and hands their impulses
     /// (as `design` returns them) back with the state, so the module on the main thread needs
     /// no solver and never waits for one. Each is checked as `exportShaper` checks a shaper
-    /// and used for the spec at its index, which still gives the label, the family and the
-    /// shaped move.
+    /// and used for the spec at its index, which still gives the label and the family.
     #[serde(default)]
     designed: Vec<Option<ShaperData>>,
 }
@@ -830,6 +829,7 @@ fn series_colors(
 /// `renderPlayground(state, canvases)`: everything one frame of the page needs, in one call.
 ///
 /// `state = { modes, shapers: [{ family, …parameters }] (1 … 4; or `shaper` for one),
+/// designed?: [shaper | null] (shapers designed elsewhere, by index),
 /// view: { fromHz, toHz, points, vtol, scv, pixelRatio, mismatch, command, plant, samples,
 /// duration, mapShaper, seriesColors, mapFrequencyPoints, mapDampingPoints, dampingTo, dampingPoints,
 /// spectrumPoints } }` (README, "JavaScript API"); `canvases = { impulses?, sensitivity?,
