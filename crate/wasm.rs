@@ -100,7 +100,13 @@ fn mode_from_js(value: JsValue, what: &str) -> Result<Mode, Error> {
 #[wasm_bindgen]
 pub fn design(spec: JsValue) -> Result<JsValue, JsValue> {
     let request: DesignRequest = from_js(spec, "").map_err(js_error)?;
+    #[cfg(feature = "js-api")]
     let shaper = design::design(&request).map_err(js_error)?;
+    // The page's design worker's module: the solved families alone (README, *Playground*).
+    #[cfg(not(feature = "js-api"))]
+    let shaper = Mode::list(&request.modes)
+        .and_then(|modes| design::design_solved_for(&request.shaper, &modes))
+        .map_err(js_error)?;
     to_js(&shaper.to_data())
 }
 

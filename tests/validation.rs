@@ -159,3 +159,52 @@ fn insensitivity_rejects_bad_vtol_and_reports_empty_bands() {
     let band = insensitivity(&Shaper::identity(), &mode, 0.05).unwrap();
     assert_eq!((band.width, band.low_hz, band.high_hz), (0.0, 1.0, 1.0));
 }
+
+/// The page's design worker designs with `design_solved_for` (Cargo feature `js-designer`):
+/// for the solved families it is `design_for`, impulse for impulse and error for error; every
+/// other family is refused at `family`.
+#[wasm_bindgen_test(unsupported = test)]
+fn design_solved_for_is_design_for_on_the_solved_families_only() {
+    use input_shaping::design::{design_for, design_solved_for};
+    let spec = |json: &str| -> ShaperSpec { serde_json::from_str(json).unwrap() };
+    let pelaez = [Mode::new(0.5, 0.002).unwrap()];
+    let two = [Mode::new(1.0, 0.02).unwrap(), Mode::new(2.7, 0.02).unwrap()];
+    let kamel = [Mode::new(30.0 / std::f64::consts::TAU, 0.02).unwrap()];
+    let sampled =
+        r#"{"family":"sampled","periodS":0.012,"impulses":36,"delaySamples":17,"plantGain":8e-4"#;
+    let cases: [(String, &[Mode]); 6] = [
+        (
+            r#"{"family":"si","vtol":0.05,"insensitivity":0.7}"#.into(),
+            &pelaez,
+        ),
+        (
+            r#"{"family":"si","vtol":0.05,"insensitivity":0.3}"#.into(),
+            &two,
+        ),
+        (r#"{"family":"direct","derivatives":1}"#.into(), &two),
+        (format!("{sampled}}}"), &kamel),
+        (format!(r#"{sampled},"amplitudeMin":0}}"#), &kamel),
+        // Infeasible: the same error from both.
+        (
+            r#"{"family":"si","vtol":0.05,"insensitivity":0.7,"maxDuration":0.5}"#.into(),
+            &pelaez,
+        ),
+    ];
+    for (i, (json, modes)) in cases.iter().enumerate() {
+        let s = spec(json);
+        match (design_for(&s, modes), design_solved_for(&s, modes)) {
+            (Ok(a), Ok(b)) if i < 5 => assert_eq!(a.impulses(), b.impulses(), "{json}"),
+            (Err(a), Err(b)) if i == 5 => assert_eq!(a.to_string(), b.to_string(), "{json}"),
+            (a, b) => panic!("{json}: {a:?} vs {b:?}"),
+        }
+    }
+    for json in [
+        r#"{"family":"zvd"}"#,
+        r#"{"family":"ei","vtol":0.05}"#,
+        r#"{"family":"custom","impulses":[{"time":0,"amplitude":1}]}"#,
+    ] {
+        let e = design_solved_for(&spec(json), &pelaez).unwrap_err();
+        assert_eq!(e.field(), Some("family"), "{json}: {e}");
+        assert!(design_for(&spec(json), &pelaez).is_ok(), "{json}");
+    }
+}

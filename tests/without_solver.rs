@@ -1,7 +1,7 @@
 //! A build without the Cargo feature `solver`, as the page's first wasm module is built
-//! (scripts/build.sh): the solved families answer [`Error::Unavailable`] (the page then fetches
-//! the module with the solver), every other family designs as before, and bad input to a solved
-//! family is still reported at its field, so the page shows it without fetching anything.
+//! (scripts/build.sh): the solved families answer [`Error::Unavailable`] (the page's design
+//! worker designs them instead), every other family designs as before, and bad input to a
+//! solved family is still reported at its field.
 //!
 //! Only compiled without the feature: scripts/test.sh runs
 //! `cargo test --no-default-features --test without_solver`.

@@ -503,6 +503,35 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
     Ok(shaper)
 }
 
+/// [`design_for`] for the solved families only (`si`, `direct`, `sampled`), the ones the
+/// optimisation solver designs: a module that calls this and not [`design_for`] leaves the
+/// other families' code out (the page's design worker, Cargo feature `js-designer`). Another
+/// family is refused at `family`.
+pub fn design_solved_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
+    if modes.is_empty() {
+        return Err(Error::invalid("modes", "at least one mode is required"));
+    }
+    let (shaper, guarantee) = match spec {
+        ShaperSpec::Sampled(spec) => (
+            sampled::design_for_modes(modes, spec)?.shaper,
+            Guarantee::ZeroAtModes,
+        ),
+        ShaperSpec::Si(si) => specified::si(si, modes)?,
+        ShaperSpec::Direct(d) => direct::direct(d, modes)?,
+        other => {
+            return Err(Error::invalid(
+                "family",
+                format!(
+                    "\"{}\" is not designed by the optimisation solver (only si, direct and sampled are)",
+                    other.name()
+                ),
+            ))
+        }
+    };
+    verify(&shaper, modes, &guarantee)?;
+    Ok(shaper)
+}
+
 /// Prefixes an error about a mode's own field (`damping`, `frequencyHz`) from the design for
 /// `modes[i]` with that path; errors about the spec's parameters keep their names.
 fn within_mode(e: Error, i: usize) -> Error {
