@@ -419,10 +419,33 @@ pub fn design(request: &DesignRequest) -> Result<Shaper> {
 
 /// Designs a shaper of family `spec` for already validated modes.
 pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
+    checked(spec, modes, any_family)
+}
+
+/// [`design_for`] for the solved families only (`si`, `direct`, `sampled`), the ones the
+/// optimisation solver designs: a module that calls this and not [`design_for`] leaves the
+/// other families' code out (the page's design worker, Cargo feature `js-designer`). Another
+/// family is refused at `family`.
+pub fn design_solved_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
+    checked(spec, modes, solved_family)
+}
+
+/// A family's design for modes, with what it guarantees ([`any_family`], [`solved_family`]).
+type Family = fn(&ShaperSpec, &[Mode]) -> Result<(Shaper, Guarantee)>;
+
+/// The design of `family` for `modes` (at least one), with its guarantee verified.
+fn checked(spec: &ShaperSpec, modes: &[Mode], family: Family) -> Result<Shaper> {
     if modes.is_empty() {
         return Err(Error::invalid("modes", "at least one mode is required"));
     }
-    let (shaper, guarantee) = match spec {
+    let (shaper, guarantee) = family(spec, modes)?;
+    verify(&shaper, modes, &guarantee)?;
+    Ok(shaper)
+}
+
+/// Any family's design and what it guarantees (the solved ones through [`solved_family`]).
+fn any_family(spec: &ShaperSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee)> {
+    Ok(match spec {
         ShaperSpec::Zv => (per_mode(modes, zero_vibration::zv)?, Guarantee::ZeroAtModes),
         ShaperSpec::Zvd => (
             per_mode(modes, zero_vibration::zvd)?,
@@ -445,10 +468,9 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
             },
             Guarantee::ZeroAtModes,
         ),
-        ShaperSpec::Sampled(spec) => (
-            sampled::design_for_modes(modes, spec)?.shaper,
-            Guarantee::ZeroAtModes,
-        ),
+        ShaperSpec::Sampled(_) | ShaperSpec::Si(_) | ShaperSpec::Direct(_) => {
+            return solved_family(spec, modes)
+        }
         ShaperSpec::Ei { vtol } => extra_insensitive::for_modes(modes, 1, *vtol)?,
         ShaperSpec::Ei2 { vtol } => extra_insensitive::for_modes(modes, 2, *vtol)?,
         ShaperSpec::Ei3 { vtol } => extra_insensitive::for_modes(modes, 3, *vtol)?,
@@ -496,40 +518,27 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
                 ]),
             )
         }
-        ShaperSpec::Si(si) => specified::si(si, modes)?,
-        ShaperSpec::Direct(d) => direct::direct(d, modes)?,
-    };
-    verify(&shaper, modes, &guarantee)?;
-    Ok(shaper)
+    })
 }
 
-/// [`design_for`] for the solved families only (`si`, `direct`, `sampled`), the ones the
-/// optimisation solver designs: a module that calls this and not [`design_for`] leaves the
-/// other families' code out (the page's design worker, Cargo feature `js-designer`). Another
+/// The solved families' designs (`sampled`, `si`, `direct`) and what they guarantee; any other
 /// family is refused at `family`.
-pub fn design_solved_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
-    if modes.is_empty() {
-        return Err(Error::invalid("modes", "at least one mode is required"));
-    }
-    let (shaper, guarantee) = match spec {
-        ShaperSpec::Sampled(spec) => (
+fn solved_family(spec: &ShaperSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee)> {
+    match spec {
+        ShaperSpec::Sampled(spec) => Ok((
             sampled::design_for_modes(modes, spec)?.shaper,
             Guarantee::ZeroAtModes,
-        ),
-        ShaperSpec::Si(si) => specified::si(si, modes)?,
-        ShaperSpec::Direct(d) => direct::direct(d, modes)?,
-        other => {
-            return Err(Error::invalid(
-                "family",
-                format!(
-                    "\"{}\" is not designed by the optimisation solver (only si, direct and sampled are)",
-                    other.name()
-                ),
-            ))
-        }
-    };
-    verify(&shaper, modes, &guarantee)?;
-    Ok(shaper)
+        )),
+        ShaperSpec::Si(si) => specified::si(si, modes),
+        ShaperSpec::Direct(d) => direct::direct(d, modes),
+        other => Err(Error::invalid(
+            "family",
+            format!(
+                "\"{}\" is not designed by the optimisation solver (only si, direct and sampled are)",
+                other.name()
+            ),
+        )),
+    }
 }
 
 /// Prefixes an error about a mode's own field (`damping`, `frequencyHz`) from the design for
