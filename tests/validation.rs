@@ -167,6 +167,9 @@ fn insensitivity_rejects_bad_vtol_and_reports_empty_bands() {
 fn design_solved_for_is_design_for_on_the_solved_families_only() {
     use input_shaping::design::{design_for, design_solved_for};
     let spec = |json: &str| -> ShaperSpec { serde_json::from_str(json).unwrap() };
+    // Peláez & Singhose 2002's carrousel (0.5 Hz, ζ 0.002, SI with I = 0.7 at 5 %); the page's
+    // two-mode preset (1 and 2.7 Hz); Kamel, Lange & Hirzinger's robot joint (ω = 30 rad/s,
+    // ζ = 0.02, T = 12 ms, 36 impulses, m = 17, K = 8e-4).
     let pelaez = [Mode::new(0.5, 0.002).unwrap()];
     let two = [Mode::new(1.0, 0.02).unwrap(), Mode::new(2.7, 0.02).unwrap()];
     let kamel = [Mode::new(30.0 / std::f64::consts::TAU, 0.02).unwrap()];
@@ -184,7 +187,7 @@ fn design_solved_for_is_design_for_on_the_solved_families_only() {
         (r#"{"family":"direct","derivatives":1}"#.into(), &two),
         (format!("{sampled}}}"), &kamel),
         (format!(r#"{sampled},"amplitudeMin":0}}"#), &kamel),
-        // Infeasible: the same error from both.
+        // Infeasible (a 0.5 Hz period is 2 s): the same error from both.
         (
             r#"{"family":"si","vtol":0.05,"insensitivity":0.7,"maxDuration":0.5}"#.into(),
             &pelaez,
