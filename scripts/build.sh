@@ -3,8 +3,8 @@
 # then shrinks each wasm with npm's binaryen (Debian's wasm-opt 108 breaks it; see README).
 #
 # Each wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
-# library with the crate (-Z build-std) at the release profile's opt-level "z" and LTO, with
-# panic locations left out (-Z location-detail=none; panic messages stay): same code, same
+# library with the crate (-Z build-std) at the module's opt-level ("z", or "s" for the page's
+# main thread; below) and LTO, with panic locations left out (-Z location-detail=none; panic messages stay): same code, same
 # results, ~24 KB less gzip (README, *Shipped size*). std's `optimize_for_size` feature would
 # save 7 KB more, but it formats floats (every tick label) with Dragon4 only, not Grisu. Without
 # that toolchain (setup could not install it), or with STABLE=1, it is built by stable Rust.
