@@ -4,8 +4,8 @@
 #
 # Each wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
 # library with the crate (-Z build-std) at the module's opt-level ("z", or "s" for the page's
-# main thread; below) and LTO, with panic locations left out (-Z location-detail=none; panic messages stay): same code, same
-# results, ~24 KB less gzip (README, *Shipped size*). std's `optimize_for_size` feature would
+# main thread; below) and LTO, with panic locations left out (-Z location-detail=none; panic
+# messages stay): same code, same results, ~24 KB less gzip (README, *Shipped size*). std's `optimize_for_size` feature would
 # save 7 KB more, but it formats floats (every tick label) with Dragon4 only, not Grisu. Without
 # that toolchain (setup could not install it), or with STABLE=1, it is built by stable Rust.
 set -euo pipefail
@@ -37,8 +37,8 @@ fi
 #
 # The main thread's module (playground) runs every update of the page, so it is optimised for
 # speed within the size budget: opt-level "s" and `wasm-opt -Os`, not "z" and `-Oz`. In
-# alternated runs of the page benchmark a 4-shaper update was ~20 % faster at the p50 for
-# 36 KB more gzip (docs/page-performance.md, *Optimisation level*). Rust's optimisation
+# alternated runs of the page benchmark a 4-shaper update was ~15–25 % faster at the p50 for
+# 17 KB more gzip (docs/page-performance.md, *Optimisation level*). Rust's optimisation
 # levels do not change floating-point results. The other modules stay at "z".
 # build_module FEATURES OUT_DIR OUT_NAME [OPT_LEVEL]
 build_module() {
