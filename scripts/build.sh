@@ -7,7 +7,8 @@
 # main thread; below) and LTO, with panic locations left out (-Z location-detail=none; panic
 # messages stay): same code, same results, ~24 KB less gzip (README, *Shipped size*). std's
 # `optimize_for_size` feature would save 7 KB more, but it formats floats (every tick label)
-# with Dragon4 only, not Grisu. Without that toolchain (setup could not install it), or with STABLE=1, it is built by stable Rust.
+# with Dragon4 only, not Grisu. Without that toolchain (setup could not install it), or with
+# STABLE=1, it is built by stable Rust.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
