@@ -38,13 +38,13 @@ fi
 #
 # The main thread's module (playground) runs every update of the page, so it is optimised for
 # speed within the size budget: opt-level "s" and `wasm-opt -Os`, not "z" and `-Oz`. In
-# alternated runs of the page benchmark a 4-shaper update was ~15–25 % faster at the p50 for
-# 17 KB more gzip (docs/page-performance.md, *Optimisation level*). Rust's optimisation
+# alternated runs of the page benchmark a 4-shaper mode edit was ~17 % faster (median of 8
+# paired runs, at the p50 and at the p95) for 17 KB more gzip (docs/page-performance.md, *Optimisation level*). Rust's optimisation
 # levels do not change floating-point results. The other modules stay at "z".
 # build_module FEATURES OUT_DIR OUT_NAME [OPT_LEVEL]
 build_module() {
   local features=$1 out=$2 name=$3 opt=${4:-z} dir=""
-  export CARGO_PROFILE_RELEASE_OPT_LEVEL=$opt
+  local -x CARGO_PROFILE_RELEASE_OPT_LEVEL=$opt # this module's cargo builds only
   if [ "$use_nightly" = 1 ]; then
     # Its own target directory: other RUSTFLAGS and std would rebuild the stable builds' cache.
     if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build --release --lib --target "$target" \
