@@ -321,16 +321,10 @@ pub fn draw_sensitivity_map_with<DB: DrawingBackend>(
         .y_label_area_size(style.px(52.0))
         .build_cartesian_2d(f_lo..f_hi, z_lo..z_hi)
         .map_err(render_error)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("frequency (Hz)")
-        .y_desc("damping ratio ζ")
-        .label_style(("sans-serif", style.font(12.0)))
-        .axis_desc_style(("sans-serif", style.font(13.0)))
-        .draw()
-        .map_err(render_error)?;
-
+    // The cells first, the axes and their labels after: a canvas' `putImageData` writes the
+    // pixels at once, so whatever was drawn before it is rasterised inside the update (the
+    // labels: most of the bitmap's cost); drawn after, they are rasterised with the frame.
+    // The axes and labels lie in the label areas, beside the cells.
     let (fe, ze) = (cell_edges(f), cell_edges(z));
     match cells {
         MapCells::Rectangles => {
@@ -372,6 +366,15 @@ pub fn draw_sensitivity_map_with<DB: DrawingBackend>(
                 .map_err(render_error)?;
         }
     }
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("frequency (Hz)")
+        .y_desc("damping ratio ζ")
+        .label_style(("sans-serif", style.font(12.0)))
+        .axis_desc_style(("sans-serif", style.font(13.0)))
+        .draw()
+        .map_err(render_error)?;
     let mut keys = Legend::default();
 
     if let Some(vtol) = vtol {
