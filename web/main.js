@@ -259,6 +259,13 @@ function showError(error) {
 // ---------- results ----------
 /** The impulses each impulse table shows, as JSON (by table body). */
 const impulseKeys = new WeakMap();
+/**
+ * Rows an impulse table shows until its "Show all" button is pressed: a multi-mode ZV-D³ has
+ * 125 impulses, and every row's text changes on a frequency edit (the exports have them all).
+ */
+const IMPULSE_ROWS = 20;
+/** Impulse tables (by index) whose every row is shown; reset when the tables are rebuilt. */
+const expandedTables = new Set();
 
 function showResults(result, st, kept) {
   const { results } = result;
@@ -289,18 +296,15 @@ function showResults(result, st, kept) {
 
   showSimulation(result, color);
 
-  rebuildIf($('impulse-tables'), labels, () => results.map((r, k) => el('table', { class: 'impulses', id: `impulses-${k}` },
+  if (rebuildIf($('impulse-tables'), labels, () => results.map((r, k) => el('table', { class: 'impulses', id: `impulses-${k}` },
     el('caption', {}, el('span', { class: 'swatch', style: `background:${color(k)}` }), r.label),
     el('thead', {}, el('tr', {}, el('th', { scope: 'col' }, '#'), el('th', { scope: 'col' }, 'time (s)'), el('th', { scope: 'col' }, 'amplitude'))),
-    el('tbody', {}))));
-  results.forEach((r, k) => {
-    // Unchanged impulses (a mismatch or command edit) are not re-read cell by cell.
-    const body = $(`impulses-${k}`).tBodies[0];
-    const key = JSON.stringify(r.shaper.impulses);
-    if (impulseKeys.get(body) === key) return;
-    syncRows(body, r.shaper.impulses.map((imp, i) => [String(i + 1), fmt(imp.time, 10), fmt(imp.amplitude, 10)]), 0);
-    impulseKeys.set(body, key);
-  });
+    el('tbody', {}),
+    el('tfoot', {}, el('tr', {}, el('td', { colSpan: 3 },
+      el('button', { type: 'button', class: 'more', 'aria-controls': `impulses-${k}`, 'aria-expanded': 'false', onclick: () => toggleImpulseTable(k) })))))))) {
+    expandedTables.clear();
+  }
+  results.forEach((r, k) => showImpulseTable(k, r));
 
   const sel = $('export-shaper');
   const keep = sel.value;
@@ -308,6 +312,39 @@ function showResults(result, st, kept) {
     sel.value = keep && Number(keep) < results.length ? keep : '0';
   }
   showExport();
+}
+
+/**
+ * Impulse table k for result `r`: every impulse, or the first `IMPULSE_ROWS` of a longer
+ * sequence with a button to show them all (and back).
+ */
+function showImpulseTable(k, r) {
+  const table = $(`impulses-${k}`);
+  const body = table.tBodies[0];
+  const { impulses } = r.shaper;
+  const long = impulses.length > IMPULSE_ROWS;
+  const all = !long || expandedTables.has(k);
+  const shown = all ? impulses : impulses.slice(0, IMPULSE_ROWS);
+  const button = table.tFoot.querySelector('button');
+  table.tFoot.hidden = !long;
+  if (long) {
+    const text = all ? `Show the first ${IMPULSE_ROWS}` : `Show all ${impulses.length} impulses`;
+    if (button.textContent !== text) button.textContent = text;
+    button.setAttribute('aria-expanded', String(all));
+  }
+  // Unchanged impulses (a mismatch or command edit) are not re-read cell by cell.
+  const key = JSON.stringify(shown);
+  if (impulseKeys.get(body) === key) return;
+  syncRows(body, shown.map((imp, i) => [String(i + 1), fmt(imp.time, 10), fmt(imp.amplitude, 10)]), 0);
+  impulseKeys.set(body, key);
+}
+
+function toggleImpulseTable(k) {
+  const r = lastGood?.result.results[k];
+  if (!r) return;
+  if (expandedTables.has(k)) expandedTables.delete(k);
+  else expandedTables.add(k);
+  showImpulseTable(k, r);
 }
 
 /** The simulated move's metrics: the unshaped command and every shaper (`color(k)` of result k). */

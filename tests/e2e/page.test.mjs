@@ -79,6 +79,54 @@ test('changing a mode and the family changes the numbers as the core predicts', 
   await page.close();
 });
 
+test('a long impulse table shows its first 20 rows until "Show all" is pressed', async () => {
+  const { page, problems } = await env.page();
+  await page.selectOption('#shaper-0-family', 'zvdn');
+  await type(page, 'shaper-0-derivatives', 24);
+  await settle(page);
+  // ZV-D²⁴ at 2 Hz, ζ 0.05: 26 impulses, A_i = C(25, i)·Kⁱ/(1 + K)²⁵ at i·Td/2 (the binomial
+  // form of ZV convolved 25 times, Singer & Seering 1988 §2.2).
+  const [f, z] = [2, 0.05];
+  const K = Math.exp((-z * Math.PI) / Math.sqrt(1 - z * z));
+  const td = 1 / (f * Math.sqrt(1 - z * z));
+  const choose = (n, k) => { let c = 1; for (let j = 1; j <= k; j++) c = (c * (n - k + j)) / j; return c; };
+  const want = Array.from({ length: 26 }, (_, i) => [(i * td) / 2, (choose(25, i) * K ** i) / (1 + K) ** 25]);
+  const check = (rows) => rows.forEach(([t, a], i) => {
+    assert.ok(Math.abs(t - want[i][0]) < 1e-9, `time ${i}: ${t} vs ${want[i][0]}`);
+    assert.ok(Math.abs(a - want[i][1]) < 1e-9 * Math.max(1, want[i][1]), `amplitude ${i}: ${a} vs ${want[i][1]}`);
+  });
+  assert.deepEqual((await summary(page))['Impulses'], ['26']);
+  const button = page.locator('#impulses-0 tfoot button');
+  assert.equal(await button.textContent(), 'Show all 26 impulses');
+  assert.equal(await button.getAttribute('aria-expanded'), 'false');
+  let rows = await impulseRows(page);
+  assert.equal(rows.length, 20);
+  check(rows);
+  // Keyboard alone: focus the button and press Enter.
+  await button.focus();
+  await page.keyboard.press('Enter');
+  rows = await impulseRows(page);
+  assert.equal(rows.length, 26);
+  check(rows);
+  assert.equal(await button.textContent(), 'Show the first 20');
+  assert.equal(await button.getAttribute('aria-expanded'), 'true');
+  // Expanded, the table follows edits; collapsed again, 20 rows.
+  await type(page, 'mode-0-frequency', 4);
+  await settle(page);
+  rows = await impulseRows(page);
+  assert.equal(rows.length, 26);
+  assert.ok(Math.abs(rows[25][0] - want[25][0] / 2) < 1e-9, `last impulse at ${rows[25][0]}`);
+  await button.click();
+  assert.equal((await impulseRows(page)).length, 20);
+  // A short sequence has no button.
+  await type(page, 'shaper-0-derivatives', 2);
+  await settle(page);
+  assert.equal((await impulseRows(page)).length, 4);
+  assert.equal(await page.isVisible('#impulses-0 tfoot'), false);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('modes can be added and removed, shapers compared', async () => {
   const { page, problems } = await env.page();
   await page.click('#add-mode');
