@@ -1021,16 +1021,21 @@ mod expm_tests {
     /// matrix exponential `block_maps` forms, for a lightly damped 3 Hz mode driven through
     /// ω²u with a cubic command (q = 4), over sub-sample offsets from 10⁻⁵ s to the largest
     /// one the vector path takes; beyond it `substeps` refuses.
-    #[test]
-    fn vector_exponential_matches_the_matrix_one() {
-        let w = 2.0 * std::f64::consts::PI * 3.0;
-        let lti = Lti {
-            a: DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -w * w, -2.0 * 0.05 * w]),
+    /// One mode at `hz`, damping `zeta`, driven through ω²u by a cubic command (q = 4).
+    fn mode_block(hz: f64, zeta: f64) -> Lti {
+        let w = 2.0 * std::f64::consts::PI * hz;
+        Lti {
+            a: DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -w * w, -2.0 * zeta * w]),
             e: DMatrix::from_row_slice(2, 4, &[0.0, 0.0, 0.0, 0.0, w * w, 0.0, 0.0, 0.0]),
             c: DMatrix::zeros(OUTPUTS, 2),
             d: DMatrix::zeros(OUTPUTS, 4),
             blocks: vec![(0, 2)],
-        };
+        }
+    }
+
+    #[test]
+    fn vector_exponential_matches_the_matrix_one() {
+        let lti = mode_block(3.0, 0.05);
         let g = lti.generator((0, 2), 4);
         let z0 = [0.3, -1.7, 0.9, 2.5, -4.0, 11.0];
         let limit = MAX_SUBSTEPS as f64 * 0.5 / g.norm;
@@ -1063,14 +1068,7 @@ mod expm_tests {
     /// series to below 2⁻⁶⁰ of it.
     #[test]
     fn one_step_taylor_columns_match_the_term_by_term_series() {
-        let w = 2.0 * std::f64::consts::PI * 7.0;
-        let mode = Lti {
-            a: DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -w * w, -2.0 * 0.02 * w]),
-            e: DMatrix::from_row_slice(2, 4, &[0.0, 0.0, 0.0, 0.0, w * w, 0.0, 0.0, 0.0]),
-            c: DMatrix::zeros(OUTPUTS, 2),
-            d: DMatrix::zeros(OUTPUTS, 4),
-            blocks: vec![(0, 2)],
-        };
+        let mode = mode_block(7.0, 0.02);
         #[rustfmt::skip]
         let two_mass = Lti {
             a: DMatrix::from_row_slice(4, 4, &[
