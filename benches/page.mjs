@@ -15,7 +15,8 @@
 // pile up the canvases' recorded drawing until the browser rasterises several frames of it
 // inside one update: that gave the 200–500 ms maxima reported before this pacing.
 // Run: npm run bench:page   (after npm run build); RUNS=n sets the updates per case (200),
-// SHAPERS=1 or SHAPERS=4 runs only the cases with that many shapers.
+// SHAPERS=1 or SHAPERS=4 runs only the cases with that many shapers, EXPANDED=1 presses every
+// impulse table's "Show all" first (by default a table longer than 20 rows shows 20).
 import { chromium } from 'playwright-core';
 import { readFileSync } from 'node:fs';
 import { gzipSync } from 'node:zlib';
@@ -50,11 +51,15 @@ try {
   const firstLoad = [...new Set(fetched)];
   const loaded = fetched.length;
   const charts = await page.$$eval('.charts canvas', (c) => c.length);
+
   const cases = [[4, 'mode'], [4, 'mismatch'], [1, 'mode'], [1, 'mismatch']]
     .filter(([n]) => !process.env.SHAPERS || Number(process.env.SHAPERS) === n);
   for (const [shapers, edit] of cases) {
     if (shapers === 1) {
       await page.evaluate(() => { const pg = window.__playground; pg.state.shapers.splice(1); pg.state.shapers[0] = { family: 'zvd' }; pg.state.view.mapShaper = 0; pg.update(); });
+    }
+    if (process.env.EXPANDED) {
+      await page.evaluate(() => document.querySelectorAll('.impulses tfoot:not([hidden]) button[aria-expanded="false"]').forEach((b) => b.click()));
     }
     const times = await page.evaluate(async ([runs, what]) => {
       const out = [];

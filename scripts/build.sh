@@ -3,7 +3,7 @@
 # then shrinks each wasm with npm's binaryen (Debian's wasm-opt 108 breaks it; see README).
 #
 # Each wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
-# library with the crate (-Z build-std) at the module's opt-level ("z", or "s" for the page's
+# library with the crate (-Z build-std) at the module's opt-level ("z", or 2 for the page's
 # main thread; below) and LTO, with panic locations left out (-Z location-detail=none; panic
 # messages stay): same code, same results, ~24 KB less gzip (README, *Shipped size*). std's
 # `optimize_for_size` feature would save 7 KB more, but it formats floats (every tick label)
@@ -37,9 +37,11 @@ fi
 # whole API's (README, *Shipped size*). The same sources, the same results.
 #
 # The main thread's module (playground) runs every update of the page, so it is optimised for
-# speed within the size budget: opt-level "s" and `wasm-opt -Os`, not "z" and `-Oz`. In
-# alternated runs of the page benchmark a 4-shaper mode edit was ~17 % faster (median of 8
-# paired runs, at the p50 and at the p95) for 17 KB more gzip (docs/page-performance.md, *Optimisation level*). Rust's optimisation
+# speed within the size budget: opt-level 2 and `wasm-opt -O2`, not "z" and `-Oz`. In
+# alternated runs of the page benchmark a 4-shaper mode edit was faster at "s" than at "z"
+# (~17 %, 8 paired runs) and faster again at 2 (5 paired runs), for 17 + 40 KB more gzip:
+# the first load is ~5 KB under its 300 KB budget (docs/page-performance.md, *Optimisation
+# level*; `shrink … s` and `build_module … s` below give back the 40 KB). Rust's optimisation
 # levels do not change floating-point results. The other modules stay at "z".
 # build_module FEATURES OUT_DIR OUT_NAME [OPT_LEVEL]
 build_module() {
@@ -50,7 +52,7 @@ build_module() {
     if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build --release --lib --target "$target" \
       --no-default-features --features "$features" --target-dir target/shipped -Z build-std=std,panic_abort; then
       dir=target/shipped
-      how="$nightly, std built for size"
+      how="$nightly, std built with it at opt-level $opt"
     else
       echo "[build] the $nightly build failed: building with stable Rust instead (larger wasm)" >&2
       use_nightly=0
@@ -68,7 +70,7 @@ build_module() {
 }
 
 # Each module's wasm-opt runs in the background while the next one compiles.
-# shrink WASM [LEVEL]   (wasm-opt's -Oz, or -Os for the speed-tuned module)
+# shrink WASM [LEVEL]   (wasm-opt's -Oz, or -O2 for the speed-tuned module)
 shrink() {
   local wasm=$1 level=${2:-z}
   if [ -x node_modules/.bin/wasm-opt ]; then
@@ -81,8 +83,8 @@ rm -rf pkg
 pids=()
 build_module js-api pkg input_shaping
 shrink pkg/input_shaping_bg.wasm & pids+=($!)
-build_module js-playground pkg/page playground s
-shrink pkg/page/playground_bg.wasm s & pids+=($!)
+build_module js-playground pkg/page playground 2
+shrink pkg/page/playground_bg.wasm 2 & pids+=($!)
 build_module js-designer,solver pkg/page designer
 shrink pkg/page/designer_bg.wasm & pids+=($!)
 build_module js-recording pkg/page recording
