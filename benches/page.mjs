@@ -51,7 +51,6 @@ try {
   const firstLoad = [...new Set(fetched)];
   const loaded = fetched.length;
   const charts = await page.$$eval('.charts canvas', (c) => c.length);
-
   const cases = [[4, 'mode'], [4, 'mismatch'], [1, 'mode'], [1, 'mismatch']]
     .filter(([n]) => !process.env.SHAPERS || Number(process.env.SHAPERS) === n);
   for (const [shapers, edit] of cases) {

@@ -326,11 +326,11 @@ function showImpulseTable(k, r) {
   const all = !long || expandedTables.has(k);
   const shown = all ? impulses : impulses.slice(0, IMPULSE_ROWS);
   const button = table.tFoot.querySelector('button');
-  table.tFoot.hidden = !long;
+  if (table.tFoot.hidden === long) table.tFoot.hidden = !long;
   if (long) {
     const text = all ? `Show the first ${IMPULSE_ROWS}` : `Show all ${impulses.length} impulses`;
     if (button.textContent !== text) button.textContent = text;
-    button.setAttribute('aria-expanded', String(all));
+    if (button.getAttribute('aria-expanded') !== String(all)) button.setAttribute('aria-expanded', String(all));
   }
   // Unchanged impulses (a mismatch or command edit) are not re-read cell by cell.
   const key = JSON.stringify(shown);

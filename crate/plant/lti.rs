@@ -1017,10 +1017,6 @@ mod expm_tests {
         assert!(rel < 1e-12, "{rel}");
     }
 
-    /// A knot's e^{Mδ}·z from the vector series (the common path of `respond`) against the
-    /// matrix exponential `block_maps` forms, for a lightly damped 3 Hz mode driven through
-    /// ω²u with a cubic command (q = 4), over sub-sample offsets from 10⁻⁵ s to the largest
-    /// one the vector path takes; beyond it `substeps` refuses.
     /// One mode at `hz`, damping `zeta`, driven through ω²u by a cubic command (q = 4).
     fn mode_block(hz: f64, zeta: f64) -> Lti {
         let w = 2.0 * std::f64::consts::PI * hz;
@@ -1033,6 +1029,11 @@ mod expm_tests {
         }
     }
 
+    /// A knot's e^{Mδ}·z as `respond` forms it (`apply`: the kept Taylor columns for the
+    /// small δ, the vector series in substeps beyond) against the matrix exponential
+    /// `block_maps` forms, for a lightly damped 3 Hz mode driven through
+    /// ω²u with a cubic command (q = 4), over sub-sample offsets from 10⁻⁵ s to the largest
+    /// one the vector path takes; beyond it `substeps` refuses.
     #[test]
     fn vector_exponential_matches_the_matrix_one() {
         let lti = mode_block(3.0, 0.05);
