@@ -58,7 +58,7 @@ test(`${STEPS} random inputs and hashes: no exception, never blank, last good re
     if (r() < 0.15) {
       await page.evaluate((h) => { location.hash = h; }, randomHash(r));
     } else if (r() < 0.1) {
-      const buttons = await page.$$('button:not([disabled]):not(#copy-link):not(#export-copy):not(#save-state):not(#export-download)');
+      const buttons = await page.$$('button:not([disabled]):not(#copy-link):not(#export-copy):not(#save-state):not(#export-download):visible');
       if (buttons.length) await buttons[Math.floor(r() * buttons.length)].click();
     } else {
       const inputs = await page.$$('input[type=number], input[type=text], select, textarea:not([readonly])');
