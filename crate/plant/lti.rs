@@ -17,6 +17,7 @@ use crate::command::{Piecewise, ORDER};
 use crate::error::{Error, Result};
 use nalgebra::DMatrix;
 use std::collections::HashMap;
+use std::sync::OnceLock;
 
 /// Number of output rows of an [`Lti`] plant.
 pub const OUTPUTS: usize = 6;
@@ -208,7 +209,6 @@ impl Lti {
             d,
             norm,
             powers: Vec::new(),
-            reach: taylor_reach(),
         };
         g.powers = g.taylor_columns();
         g
@@ -680,24 +680,26 @@ struct Generator {
     /// `powers[(j·TAYLOR_TERMS + k)·size ..][..size]`: the Taylor coefficients of e^{Bh}eⱼ,
     /// so a knot's e^{Bh}·y is a polynomial in h per non-zero yⱼ (see [`Generator::apply`]).
     powers: Vec<f64>,
-    /// `reach[K − 1]`: the largest ‖B‖δ for which K Taylor terms leave a tail bound
-    /// (‖B‖δ)ᴷ/K!·e^{½} ≤ 2⁻⁶⁰ (K = 1 … `TAYLOR_TERMS` − 1).
-    reach: [f64; TAYLOR_TERMS - 1],
 }
 
 /// Taylor terms kept per unit vector: enough for ‖B‖h ≤ ½, where 0.5¹⁸/18! < 10⁻²¹.
 const TAYLOR_TERMS: usize = 18;
 
-/// [`Generator::reach`]: x_K = (2⁻⁶⁰·K!/e^{½})^{1/K}.
-fn taylor_reach() -> [f64; TAYLOR_TERMS - 1] {
-    let mut reach = [0.0; TAYLOR_TERMS - 1];
-    let mut factorial = 1.0;
-    for (k, r) in reach.iter_mut().enumerate() {
-        let terms = (k + 1) as f64;
-        factorial *= terms;
-        *r = (f64::powi(2.0, -60) * factorial / 0.5_f64.exp()).powf(terms.recip());
-    }
-    reach
+/// `reach[K − 1]`: the largest ‖B‖δ for which K Taylor terms leave a tail bound
+/// (‖B‖δ)ᴷ/K!·e^{½} ≤ 2⁻⁶⁰ (K = 1 … `TAYLOR_TERMS` − 1), x_K = (2⁻⁶⁰·K!/e^{½})^{1/K}: the
+/// same for every block, formed once.
+fn taylor_reach() -> &'static [f64; TAYLOR_TERMS - 1] {
+    static REACH: OnceLock<[f64; TAYLOR_TERMS - 1]> = OnceLock::new();
+    REACH.get_or_init(|| {
+        let mut reach = [0.0; TAYLOR_TERMS - 1];
+        let mut factorial = 1.0;
+        for (k, r) in reach.iter_mut().enumerate() {
+            let terms = (k + 1) as f64;
+            factorial *= terms;
+            *r = (f64::powi(2.0, -60) * factorial / 0.5_f64.exp()).powf(terms.recip());
+        }
+        reach
+    })
 }
 
 /// Buffers reused across knots.
@@ -767,7 +769,7 @@ impl Generator {
             return false;
         }
         // K terms (k = 0 … K − 1): the first K with xᴷ/K!·e^{½} ≤ 2⁻⁶⁰ (K ≤ 17 for x ≤ ½).
-        let terms = 1 + self.reach.iter().take_while(|&&r| x > r).count();
+        let terms = 1 + taylor_reach().iter().take_while(|&&r| x > r).count();
         work.clear();
         work.resize(2 * keep, 0.0);
         let (sum, acc) = work.split_at_mut(keep);
