@@ -91,8 +91,10 @@ test('a long impulse table shows its first 20 rows until "Show all" is pressed',
   await page.selectOption('#shaper-0-family', 'zvdn');
   await type(page, 'shaper-0-derivatives', 24);
   await settle(page);
-  // ZV-D²⁴ at 2 Hz, ζ 0.05: 26 impulses, A_i = C(25, i)·Kⁱ/(1 + K)²⁵ at i·Td/2 (the binomial
-  // form of ZV convolved 25 times, Singer & Seering 1988 §2.2).
+  // ZV-D²⁴ at 2 Hz, ζ 0.05: 26 impulses, A_i = C(25, i)·Kⁱ/(1 + K)²⁵ at i·Td/2 — the
+  // two-impulse solution of Singer & Seering 1988 eq. 6 (1/(1 + K), K/(1 + K) at 0, Td/2)
+  // convolved with itself 25 times, which zeroes the first 24 derivatives of eq. 6 (their
+  // eq. 8); their ZVD and ZVDD are the cases of 2 and 3 factors.
   const [f, z] = [2, 0.05];
   const K = Math.exp((-z * Math.PI) / Math.sqrt(1 - z * z));
   const td = 1 / (f * Math.sqrt(1 - z * z));
