@@ -13,8 +13,8 @@
 //! Outputs are rows y = C x + D w: base position/velocity/acceleration and endpoint
 //! position/velocity/acceleration.
 
-use crate::command::{Piecewise, ORDER};
 use crate::error::{Error, Result};
+use crate::piecewise::{Piecewise, ORDER};
 use nalgebra::DMatrix;
 use std::collections::HashMap;
 use std::sync::OnceLock;
@@ -517,7 +517,7 @@ impl Lti {
 }
 
 /// `out[k] = Σ_{m ≥ k} state[m] hᵐ⁻ᵏ/(m − k)!`: a polynomial's derivatives shifted by `h`
-/// (the same sums, in the same order, as `command::taylor_shift`, on the first
+/// (the same sums, in the same order, as `piecewise::taylor_shift`, on the first
 /// `state.len()` derivatives only).
 #[inline]
 fn taylor_shift(state: &[f64], h: f64, out: &mut [f64]) {
@@ -539,7 +539,7 @@ fn taylor_shift_fixed<const Q: usize>(state: &[f64], h: f64, out: &mut [f64]) {
     for (d, v) in st.iter_mut().zip(state) {
         *d = *v;
     }
-    // hp[i] = hⁱ/i! by the recurrence pw *= h / i, as `command::taylor_shift` forms it (the
+    // hp[i] = hⁱ/i! by the recurrence pw *= h / i, as `piecewise::taylor_shift` forms it (the
     // constant divisions by 1 and 2 are exact, so the compiler turns them into moves and
     // multiplications without changing a bit).
     let mut hp = [1.0; Q];

@@ -6,13 +6,14 @@
 //! Cargo.toml). A build with only some of them leaves helpers unused, hence the allow there.
 #![cfg_attr(not(feature = "js-api"), allow(dead_code, unused_imports))]
 
-use crate::canvas::Canvas;
+use super::canvas::Canvas;
 use crate::chart::{self, ChartStyle};
-use crate::command::{Command, CommandSpec, Knot, Piecewise, ORDER};
+use crate::command::{Command, CommandSpec};
 use crate::design::{self, DesignRequest, ShaperSpec};
 use crate::error::Error;
 use crate::metrics::Metrics;
 use crate::mode::{Mode, ModeSpec};
+use crate::piecewise::{Knot, Piecewise, ORDER};
 use crate::plant::{ModalPlant, Pendulum, PendulumSpec, Plant};
 use crate::robustness::RobustnessRow;
 use crate::shaper::{Shaper, ShaperData};
@@ -60,7 +61,7 @@ pub(crate) fn from_js<T: DeserializeOwned>(value: JsValue, what: &str) -> Result
             reason: "is missing".into(),
         });
     }
-    crate::jsde::deserialize(value).map_err(|(path, e)| {
+    super::jsde::deserialize(value).map_err(|(path, e)| {
         let field = match path.as_str() {
             "." | "" | "?" => what.to_string(),
             p if what.is_empty() => p.to_string(),
@@ -1321,8 +1322,8 @@ pub fn quantize(shaper: JsValue, mode: JsValue, options: JsValue) -> Result<JsVa
 #[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn simulate(spec: JsValue) -> Result<JsValue, JsValue> {
-    let spec: crate::simulate::SimulationSpec = from_js(spec, "").map_err(js_error)?;
-    let result = crate::simulate::run(&spec).map_err(js_error)?;
+    let spec: crate::scenario::SimulationSpec = from_js(spec, "").map_err(js_error)?;
+    let result = crate::scenario::run(&spec).map_err(js_error)?;
     to_js(&result)
 }
 
@@ -1332,7 +1333,7 @@ pub fn simulate(spec: JsValue) -> Result<JsValue, JsValue> {
 #[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn spectrum(spec: JsValue) -> Result<JsValue, JsValue> {
-    let spec: crate::spectrum::SpectrumSpec = from_js(spec, "").map_err(js_error)?;
-    let result = crate::spectrum::spectrum_for(&spec).map_err(js_error)?;
+    let spec: crate::scenario::SpectrumSpec = from_js(spec, "").map_err(js_error)?;
+    let result = crate::scenario::spectrum_for(&spec).map_err(js_error)?;
     to_js(&result)
 }
