@@ -39,6 +39,31 @@
 //! - `js` (wasm32 only): everything for JavaScript — the JavaScript API (`design`,
 //!   `residualVibration`, `sensitivity`, …), its measured-data part (`parseRecording`, `welch`,
 //!   `identifyModes`, …), the reader of JS values and the canvas backend.
+//!
+//! ## Layers
+//!
+//! Each line may import only from the lines above it, and modules on one line may import each
+//! other only one way (no circles). `tests/layers.rs` reads this list and fails `npm test` when
+//! an import points up or two modules import each other; a new top-level module must be
+//! listed here.
+//!
+//! ```text
+//! ground     error mode shaper sort tagged
+//! analysis   vibration smoothing
+//! numerics   solve
+//! design     design
+//! motion     piecewise profile command
+//! plants     plant
+//! results    simulate metrics spectrum robustness
+//! scenario   scenario
+//! measured   measure
+//! charts     chart
+//! export     export
+//! js         js
+//! ```
+//!
+//! `robustness` (durations and insensitivities across families) designs every family, so it
+//! sits above design, with the other results, not with the single-shaper analysis.
 
 pub mod chart;
 pub mod command;
