@@ -544,7 +544,8 @@ def run(paths, scv=DEFAULT_SCV, max_smoothing=None, max_vibrs_pcnt=None, shapers
         "files": list(paths),
         "options": {"scv": scv, "max_smoothing": max_smoothing,
                     "max_vibrs_pcnt": max_vibrs_pcnt, "shapers": list(shapers or AUTOTUNE_SHAPERS),
-                    "max_freq": max_freq, "damping_ratio": damping_ratio or DEFAULT_DAMPING_RATIO},
+                    "max_freq": max_freq, "damping_ratio": damping_ratio or DEFAULT_DAMPING_RATIO,
+                    "test_damping_ratios": list(test_damping or TEST_DAMPING_RATIOS)},
         "datasets": [{"name": d.name, "kind": getattr(d, "kind", "?"), "bins": int(d.freqs.size),
                       "normalized_on_read": getattr(d, "kind", "") != "calibration_data"}
                      for d in datasets],
