@@ -394,6 +394,16 @@ VARIANTS = [
     ("resonances_x_m1.csv", {"scv": 10.0}),
     ("resonances_x_z008f47.csv", {"shapers": ["zvd", "mzv", "zv"]}),
     ("resonances_x_z001f88.csv", {"damping_ratio": 0.05, "test_damping_ratios": [0.01, 0.02]}),
+] + [
+    # the closed-form EI shapers of the releases before the polynomial fits (defs=classic),
+    # and with them the 2021-2023 selection rule (legacy=True)
+    (fn, {"defs": "classic"}) for fn in (
+        "resonances_x_m1.csv", "resonances_y_m1.csv", "resonances_y_three.csv",
+        "resonances_x_two45x14.csv", "resonances_y_z003f23.csv", "resonances_x_z001f88.csv",
+        "resonances_y_z020f61.csv", "resonances_x_z008f47.csv")
+] + [
+    (fn, {"defs": "classic", "legacy": True}) for fn in (
+        "resonances_x_m1.csv", "resonances_y_m1.csv", "resonances_y_three.csv")
 ]
 
 
