@@ -73,6 +73,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import klipper_reference as kr  # noqa: E402
 
 G = 9806.65
+# sensor drift (mm/s^2, s): offset, slope per second, a slow sine; per channel k = 0, 1, 2 the
+# offset is scaled by (1 - k/2), the slope by (1 + k), the sine's phase shifted by k rad
+DRIFT = {"offset": 60.0, "slope": 3.0, "sine": 25.0, "period": 40.0}
 SCALE_XY = 0.003774 * G
 SCALE_Z = 0.003906 * G
 MOUNT_DEG = 2.0
@@ -228,7 +231,7 @@ def record(case):
     rng = np.random.default_rng(case["seed"])
     sig = case["noise"]
     span = t[-1]
-    drift = case.get("drift", {"offset": 60.0, "slope": 3.0, "sine": 25.0, "period": 40.0})
+    drift = case.get("drift", DRIFT)
 
     def drift_of(k):
         return (drift["offset"] * (1 - 0.5 * k) + drift["slope"] * t * (1 + k)
@@ -327,7 +330,7 @@ def cases():
                   modes=[mode(38.0, 0.04, 16.0), mode(53.2, 0.04, 12.0)],
                   excitation=exc(33.0, 58.0, hps=2.0),
                   outputs=["raw", "resonances", "calibration_data"],
-                  note="two modes, ratio 1.4, the second 4 dB weaker (peak_db 16 vs 12)"))
+                  note="two modes, ratio 1.4, the second's peak 4 dB below the first's"))
     c.append(dict(name="z018f61", axis="x", rate=3200.0, seed=104, noise=150.0,
                   modes=[mode(61.0, 0.18, 9.0)], excitation=exc(40.0, 90.0, hps=5.0),
                   outputs=["raw", "resonances"],
@@ -370,6 +373,7 @@ def cases():
                   note="single mode, noise 400 mm/s^2 (PSD floor ~100); " + full))
     for case in c:
         normalize_gains(case["modes"])
+        case.setdefault("drift", dict(DRIFT))
         if case["name"] == "z001f88":
             # a peak of 1/(2 zeta) = 50 would clip the sensor at Klipper's default 60
             # mm/s^2/Hz: the test is run with ACCEL_PER_HZ=20
