@@ -355,9 +355,7 @@ fn check(axes: &[AxisShaper], allowed: &[&str], firmware: &str) -> Result<Vec<Ax
             ));
         }
         let shaper = match &a.impulses {
-            Some(imps) => {
-                Some(Shaper::new(imps.clone()).map_err(|e| e.within(&format!("{field}")))?)
-            }
+            Some(imps) => Some(Shaper::new(imps.clone()).map_err(|e| e.within(&field))?),
             None => None,
         };
         if let Some(m) = a.max_accel {
@@ -648,7 +646,7 @@ pub fn rrf_config(axes: &[AxisShaper]) -> Result<FirmwareConfig> {
     let checked = check(axes, &["x", "y", "z"], "RepRapFirmware")?;
     let first = &axes[0];
     if let Some(i) = axes.iter().position(|a| {
-        a.family.to_ascii_lowercase() != first.family.to_ascii_lowercase()
+        !a.family.eq_ignore_ascii_case(&first.family)
             || a.frequency_hz != first.frequency_hz
             || a.damping != first.damping
             || a.impulses != first.impulses
