@@ -136,3 +136,38 @@ fn welch_accepts_typed_and_plain_arrays_and_names_bad_fields() {
         Some("sampleRateHz")
     );
 }
+
+/// `firmwareConfig` across the boundary: `{ text, warnings }`, and an error's `field` naming
+/// the axis (RepRapFirmware 3.6 holds at most 5 impulses, AxisShaper.h `MaxImpulses`).
+#[wasm_bindgen_test]
+fn firmware_config_round_trip() {
+    let r = api::firmware_config_js(js(
+        r#"{"firmware":"klipperCommand","axes":[{"axis":"x","family":"mzv","frequencyHz":53.8}]}"#,
+    ))
+    .unwrap();
+    assert_eq!(
+        get(&r, "text").as_string().as_deref(),
+        Some("SET_INPUT_SHAPER SHAPER_TYPE_X=mzv SHAPER_FREQ_X=53.8 DAMPING_RATIO_X=0.1\n")
+    );
+    assert_eq!(js_sys::Array::from(&get(&r, "warnings")).length(), 0);
+    let six: Vec<String> = (0..6)
+        .map(|k| {
+            format!(
+                r#"{{"time":{},"amplitude":{}}}"#,
+                0.002 * k as f64,
+                1.0 / 6.0
+            )
+        })
+        .collect();
+    let e = api::firmware_config_js(js(&format!(
+        r#"{{"firmware":"rrf","axes":[{{"axis":"x","family":"custom","impulses":[{}]}}]}}"#,
+        six.join(",")
+    )))
+    .unwrap_err();
+    assert_eq!(
+        get(&e, "field").as_string().as_deref(),
+        Some("axes[0].impulses")
+    );
+    let e = api::firmware_config_js(js(r#"{"firmware":"repetier","axes":[]}"#)).unwrap_err();
+    assert_eq!(get(&e, "kind").as_string().as_deref(), Some("parse"));
+}
