@@ -15,6 +15,7 @@ pub mod identify;
 pub mod psd;
 pub mod recommend;
 pub mod recording;
+pub mod spectrum_file;
 
 pub use identify::{identify, Identification, IdentifiedMode, IdentifyOptions, SignalKind};
 pub use psd::{fft_spectrum, welch, FftOptions, Psd, WelchOptions, WindowKind};

@@ -37,6 +37,7 @@
 
 mod decay;
 mod half_power;
+mod model;
 mod peaks;
 mod spectrum_fit;
 
@@ -44,9 +45,91 @@ use super::psd::{check_signal, welch, Detrend, Psd, Scaling, WelchOptions, Windo
 use crate::error::{count, finite, positive, Error, Result};
 use decay::{decay_fit, find_decay};
 use half_power::{half_power, smoothed, HalfPower};
+use model::{fit_modes, ModelInput, Seed, WindowSpec};
 use peaks::{detect, Peak};
 use serde::{Deserialize, Serialize};
 use spectrum_fit::spectrum_fit;
+
+/// One mode on its way out: where its peak is and every estimate made of it.
+struct Slot {
+    peak_hz: f64,
+    peak_psd: f64,
+    prominence_db: f64,
+    estimates: Vec<Estimate>,
+}
+
+impl Slot {
+    /// Adds a spectrum-fit estimate unless it wandered off the peak.
+    fn push_fit(&mut self, f: Estimate) {
+        let e0 = self.estimates[0];
+        if (f.frequency_hz - e0.frequency_hz).abs()
+            < 3.0 * e0.frequency_hz * e0.damping.clamp(0.01, 0.3)
+        {
+            self.estimates.push(f);
+        }
+    }
+
+    fn into_mode(self) -> IdentifiedMode {
+        // The spectrum fit refines the half-power estimate; the free-decay fit replaces it
+        // when its relative damping uncertainty is smaller.
+        let estimates = self.estimates;
+        let relative = |e: &Estimate| e.damping_uncertainty / e.damping;
+        let fit = estimates.iter().find(|e| e.method == Method::SpectrumFit);
+        let decay = estimates.iter().find(|e| e.method == Method::FreeDecay);
+        let best = match (fit, decay) {
+            (Some(f), Some(d)) if relative(d) < relative(f) => *d,
+            (Some(f), _) => *f,
+            (None, Some(d)) => *d,
+            (None, None) => estimates[0],
+        };
+        IdentifiedMode {
+            frequency_hz: best.frequency_hz,
+            damping: best.damping,
+            frequency_uncertainty_hz: best.frequency_uncertainty_hz,
+            damping_uncertainty: best.damping_uncertainty,
+            method: best.method,
+            peak_frequency_hz: self.peak_hz,
+            peak_psd: self.peak_psd,
+            prominence_db: self.prominence_db,
+            estimates,
+        }
+    }
+}
+
+/// The joint fit of [`model`] seeded by the half-power estimates: each fitted mode joins its
+/// seed's slot; modes found in the residuals get slots of their own. False when it failed.
+fn joint_fit(
+    input: &ModelInput,
+    halves: &[HalfPower],
+    max_modes: usize,
+    slots: &mut Vec<Slot>,
+) -> bool {
+    let seeds: Vec<Seed> = halves
+        .iter()
+        .enumerate()
+        .map(|(i, h)| Seed {
+            frequency_hz: h.estimate.frequency_hz,
+            damping: h.estimate.damping,
+            peak_psd: h.peak_psd,
+            peak: Some(i),
+        })
+        .collect();
+    let Some(fitted) = fit_modes(input, &seeds, max_modes) else {
+        return false;
+    };
+    for m in fitted {
+        match m.peak {
+            Some(i) => slots[i].push_fit(m.estimate),
+            None => slots.push(Slot {
+                peak_hz: m.estimate.frequency_hz,
+                peak_psd: m.peak_psd,
+                prominence_db: m.standing_db,
+                estimates: vec![m.estimate],
+            }),
+        }
+    }
+    true
+}
 
 /// Most modes [`identify`] returns.
 pub const MAX_MODES: usize = 8;
@@ -355,26 +438,44 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         }
     }
     let halves: Vec<HalfPower> = found_unique.iter().map(|(_, h)| *h).collect();
-    let fitted = if halves.is_empty() {
-        None
-    } else {
-        spectrum_fit(&psd, &halves, lo, hi, options.signal)
+    let mut slots: Vec<Slot> = found_unique
+        .iter()
+        .map(|(p, h)| Slot {
+            peak_hz: h.peak_hz,
+            peak_psd: h.peak_psd,
+            prominence_db: p.prominence_db,
+            estimates: vec![h.estimate],
+        })
+        .collect();
+    let input = ModelInput {
+        frequency_hz: &psd.frequency_hz,
+        psd: &psd.psd,
+        resolution_hz: psd.resolution_hz,
+        even: true,
+        window: Some(WindowSpec {
+            kind: WindowKind::Hann,
+            length: psd.segment_length,
+            symmetric: false,
+            beta: 6.0,
+        }),
+        klipper_normalized: false,
+        kind: options.signal,
+        enbw_bins: psd.enbw_bins,
+        band: [f_lo, f_hi],
     };
-    let mut estimates: Vec<Vec<Estimate>> = halves.iter().map(|h| vec![h.estimate]).collect();
-    if let Some(fits) = &fitted {
-        for (e, f) in estimates.iter_mut().zip(fits) {
-            // A fit that wandered off its peak is not kept.
-            if (f.frequency_hz - e[0].frequency_hz).abs()
-                < 3.0 * e[0].frequency_hz * e[0].damping.max(0.01)
-            {
-                e.push(*f);
+    let joint = joint_fit(&input, &halves, options.max_modes, &mut slots);
+    if !joint && !halves.is_empty() {
+        if let Some(fits) = spectrum_fit(&psd, &halves, lo, hi, options.signal) {
+            for (slot, f) in slots.iter_mut().zip(fits) {
+                slot.push_fit(f);
             }
         }
     }
-    if options.free_decay && !halves.is_empty() {
-        let lowest = halves
+    let mut estimates: Vec<Vec<Estimate>> = slots.iter().map(|s| s.estimates.clone()).collect();
+    if options.free_decay && !slots.is_empty() {
+        let lowest = slots
             .iter()
-            .map(|h| h.estimate.frequency_hz)
+            .map(|s| s.estimates[0].frequency_hz)
             .fold(f64::INFINITY, f64::min);
         if let Some((start, end, level_db)) = find_decay(signal, fs, lowest) {
             let initial: Vec<(f64, f64)> = estimates
@@ -409,34 +510,10 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
             }
         }
     }
-    result.modes = found_unique
-        .iter()
-        .zip(estimates)
-        .map(|((peak, half), estimates)| {
-            // The spectrum fit refines the half-power estimate; the free-decay fit replaces it
-            // when its relative damping uncertainty is smaller.
-            let relative = |e: &Estimate| e.damping_uncertainty / e.damping;
-            let fit = estimates.iter().find(|e| e.method == Method::SpectrumFit);
-            let decay = estimates.iter().find(|e| e.method == Method::FreeDecay);
-            let best = match (fit, decay) {
-                (Some(f), Some(d)) if relative(d) < relative(f) => *d,
-                (Some(f), _) => *f,
-                (None, Some(d)) => *d,
-                (None, None) => estimates[0],
-            };
-            IdentifiedMode {
-                frequency_hz: best.frequency_hz,
-                damping: best.damping,
-                frequency_uncertainty_hz: best.frequency_uncertainty_hz,
-                damping_uncertainty: best.damping_uncertainty,
-                method: best.method,
-                peak_frequency_hz: half.peak_hz,
-                peak_psd: half.peak_psd,
-                prominence_db: peak.prominence_db,
-                estimates,
-            }
-        })
-        .collect();
+    for (slot, e) in slots.iter_mut().zip(estimates) {
+        slot.estimates = e;
+    }
+    result.modes = slots.into_iter().map(Slot::into_mode).collect();
     crate::sort::sort_by(&mut result.modes, |a, b| {
         a.frequency_hz.total_cmp(&b.frequency_hz)
     });
