@@ -282,11 +282,11 @@ pub(crate) fn fit_modes(
     let range = |seeds: &[Seed]| -> (f64, f64) {
         let lo = seeds
             .iter()
-            .map(|s| s.frequency_hz * (1.0 - (8.0 * s.damping).clamp(0.35, 0.8)))
+            .map(|s| s.frequency_hz * (1.0 - (8.0 * s.damping).clamp(0.6, 0.8)))
             .fold(f64::INFINITY, f64::min);
         let hi = seeds
             .iter()
-            .map(|s| s.frequency_hz * (1.0 + (8.0 * s.damping).max(0.35)))
+            .map(|s| s.frequency_hz * (1.0 + (8.0 * s.damping).max(0.8)))
             .fold(0.0, f64::max);
         (lo.max(input.band[0]), hi.min(input.band[1]))
     };
