@@ -558,7 +558,7 @@ pub fn identify_spectrum(
             format!("must be a finite number ≥ 0, got {}", p[i]),
         ));
     }
-    if let Some(i) = f.windows(2).position(|w| !(w[1] > w[0])) {
+    if let Some(i) = f.windows(2).position(|w| w[1] <= w[0] || w[1].is_nan()) {
         return Err(Error::invalid(
             format!("spectrum.frequencyHz[{}]", i + 1),
             "frequencies must increase",
