@@ -310,7 +310,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
             count("segmentLength", s, 64, n)?;
             s
         }
-        None => pow2_floor(n / 8).clamp(64, 65536),
+        None => pow2_floor(n / 4).clamp(64, 65536),
     };
     let detect_options = WelchOptions {
         sample_rate_hz: fs,
@@ -326,7 +326,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
     let df0 = psd0.resolution_hz;
     let f_lo = match options.min_frequency_hz {
         Some(f) => positive("minFrequencyHz", f)?,
-        None => 4.0 * df0,
+        None => 3.0 * df0,
     };
     let f_hi = match options.max_frequency_hz {
         Some(f) => positive("maxFrequencyHz", f)?,
