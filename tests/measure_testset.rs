@@ -147,7 +147,7 @@ fn every_case_of_the_independent_test_set() {
     let id = identify_spectrum(
         &combined[0],
         &IdentifyOptions {
-            max_modes: 3,
+            max_modes: 2,
             ..IdentifyOptions::new(f64::NAN)
         },
     )
@@ -207,8 +207,8 @@ fn every_case_of_the_independent_test_set() {
     // PSD rising to 200 Hz miss). This bound keeps what is met from regressing until the rest
     // is; it is not the target.
     assert!(
-        rows.len() - failed >= 25,
-        "{failed} of {} modes outside the targets (25 met when this bound was set)",
+        rows.len() - failed >= 33,
+        "{failed} of {} modes outside the targets (33 met when this bound was set)",
         rows.len()
     );
 }

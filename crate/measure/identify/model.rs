@@ -281,7 +281,14 @@ fn bic(fit: &FitResult, n_eff: f64) -> f64 {
 }
 
 /// Initial parameters from seeds, with gain signs from `signs` (bit i−1 flips mode i).
-fn start(seeds: &[Seed], signs: usize, floor: f64, direct: f64, edges: &[f64]) -> Vec<f64> {
+fn start(
+    seeds: &[Seed],
+    signs: usize,
+    floor: f64,
+    direct: f64,
+    exponent: f64,
+    edges: &[f64],
+) -> Vec<f64> {
     let mut x = Vec::with_capacity(3 * seeds.len() + 3);
     for (i, s) in seeds.iter().enumerate() {
         let sign = if i > 0 && (signs >> (i - 1)) & 1 == 1 {
@@ -295,7 +302,7 @@ fn start(seeds: &[Seed], signs: usize, floor: f64, direct: f64, edges: &[f64]) -
         x.push(sign * (s.peak_psd - floor).max(floor).sqrt() * 2.0 * z);
     }
     x.push(direct); // c
-    x.push(0.0); // a
+    x.push(exponent); // a
     x.push(floor.max(1e-300).ln());
     x.extend_from_slice(edges);
     x
@@ -367,6 +374,19 @@ pub(crate) fn fit_modes(
             break;
         }
     }
+    // Inside a swept band's edges the excitation is smooth; at them it is not (and the
+    // window smears them over ±2 bins): the fit keeps to the bins 2.5 bins inside.
+    let bins: Vec<usize> = bins
+        .into_iter()
+        .filter(|&k| {
+            edge_lo.is_none_or(|e| f[k] >= e + 2.0 * df)
+                && edge_hi.is_none_or(|e| f[k] <= e - 2.0 * df)
+        })
+        .collect();
+    if bins.len() < 3 * seeds.len() + 6 {
+        return None;
+    }
+    let (edge_lo, edge_hi): (Option<f64>, Option<f64>) = (None, None);
     let edges = Edges {
         low: edge_lo.is_some(),
         high: edge_hi.is_some(),
@@ -404,11 +424,17 @@ pub(crate) fn fit_modes(
         let patterns = if m <= 4 { 1usize << (m - 1) } else { 1 };
         let mut best: Option<(FitResult, usize)> = None;
         for signs in 0..patterns {
-            for c in [direct, -direct, 0.0] {
-                let x0 = start(seeds, signs, floor, c, &edge_start);
-                if let Some(r) = problem.fit(&x0, m) {
-                    if best.as_ref().is_none_or(|b| r.0.rss < b.0.rss) {
-                        best = Some(r);
+            // Starts: white (a = 0) or swept (a = 2: Klipper's acceleration ∝ f at constant
+            // Hz/s) excitation; the direct term of either sign (its level from the low end of
+            // the range under that excitation) or none.
+            for a in [0.0, 2.0] {
+                let c0 = direct / (f[problem.bins[0]] / problem.f_ref).powf(0.5 * a);
+                for c in [c0, -c0, 0.0] {
+                    let x0 = start(seeds, signs, floor, c, a, &edge_start);
+                    if let Some(r) = problem.fit(&x0, m) {
+                        if best.as_ref().is_none_or(|b| r.0.rss < b.0.rss) {
+                            best = Some(r);
+                        }
                     }
                 }
             }
