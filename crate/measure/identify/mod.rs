@@ -368,11 +368,15 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
     if peaks.is_empty() {
         return Ok(result);
     }
-    // Longer segments until the narrowest peak spans ≥ 12 bins (at least 4 segments kept).
+    // Segments from the record and the peaks: the narrowest half-power width should span 4 to
+    // 8 bins (the fit models the window's smearing, so a few bins suffice, and shorter
+    // segments average more of them: a sweep's PSD is then steadier). Longer while it spans
+    // fewer (up to n/4), or once shorter when it spans more (down to 64 samples).
     let n_max = pow2_floor(n / 4).max(n0).min(1 << 20);
     let mut psd = psd0;
     let mut widths: Vec<Option<HalfPower>>;
     let mut seg = n0;
+    let mut shrunk = false;
     loop {
         let (lo, hi) = (bin(&psd, f_lo).max(1), bin(&psd, f_hi));
         widths = peaks
@@ -409,11 +413,19 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
             .flatten()
             .map(|h| h.width_hz / psd.resolution_hz)
             .fold(f64::INFINITY, f64::min);
-        if !narrowest.is_finite() || narrowest >= 12.0 || seg >= n_max {
+        if !narrowest.is_finite() {
             break;
         }
-        let factor = (16.0 / narrowest).ceil() as usize;
-        seg = (seg * factor.next_power_of_two()).min(n_max);
+        if narrowest > 8.0 && !shrunk && seg > 64 {
+            shrunk = true;
+            let factor = pow2_floor((narrowest / 4.0).floor() as usize).max(1);
+            seg = (seg / factor).max(64);
+        } else if narrowest < 4.0 && !shrunk && seg < n_max {
+            let factor = (8.0 / narrowest).ceil() as usize;
+            seg = (seg * factor.next_power_of_two()).min(n_max);
+        } else {
+            break;
+        }
         psd = welch(
             signal,
             &WelchOptions {
