@@ -12,12 +12,14 @@
 //!    averaged over a tenth of the peak's width so the bins' noise does not move the crossings —
 //!    falls to half the peak give ζ ≈ (f₂ − f₁)/(2f_p). The natural frequency is f_p·√(1−2ζ²) for a
 //!    position signal, f_p for velocity, f_p/√(1−2ζ²) for acceleration (where each |H|² peaks).
-//! 3. **Spectrum fit** (frequency domain, refines 2). The PSD around the peaks is fitted, in
-//!    log, by the power spectrum of a modal sum driven by white noise,
-//!    S(f) = |Σᵢ gᵢ (ω/ωᵢ)^p ωᵢ² / (ωᵢ² − ω² + 2iζᵢωᵢω)|² + B, p = 2, 1, 0 for acceleration,
-//!    velocity, position (real, signed modal gains gᵢ: classically damped modes), convolved
-//!    with the window's spectral kernel |W(ν)|² where peaks are narrow, so leakage does not
-//!    widen them. Levenberg–Marquardt; every sign pattern of the gains is tried.
+//! 3. **Spectrum fit** (frequency domain, refines 2): all modes fitted jointly to the PSD by
+//!    the expected Welch estimate of a modal response to a smooth excitation — coherent modal
+//!    sum with a direct term, excitation (f/f_ref)^a with a fitted, white floor, convolved with
+//!    the window's kernel, Klipper's normalisation when a file has it — in log by
+//!    Levenberg–Marquardt, with modes hidden on a neighbour's flank added from the residuals by
+//!    an information criterion (identify/model.rs has the details). The older per-peak fit
+//!    (identify/spectrum_fit.rs: white-noise excitation, kernel only near narrow peaks) is the
+//!    fallback when the joint fit fails.
 //! 4. **Free decay** (time domain). If the recording rings down after a hit (a block of two
 //!    periods at least 20 dB above the median block, less than half of it two blocks earlier;
 //!    the decay ends where the blocks fall below twice the median), the ring-down is
@@ -536,7 +538,8 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
 
 /// Identifies the modes in a spectrum alone (a Klipper spectrum file, or a raw file's Klipper
 /// spectrum): the peaks of `spectrum.psd` (3-bin smoothing: Klipper's bins are coarse) seed the
-/// joint fit of [`model`], which models Klipper's Welch window (symmetric Kaiser β = 6) and,
+/// joint fit of the module docs' step 3 (identify/model.rs), which models Klipper's Welch
+/// window (symmetric Kaiser β = 6) and,
 /// when `spectrum.normalization` says so, its normalisation (fitted above 10 Hz only, where the
 /// released and the current Klipper agree: psd/(f + 0.1)). `options.sampleRateHz` is not used;
 /// the band defaults to [5 Hz or the second bin, the last bin].
