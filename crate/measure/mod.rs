@@ -4,7 +4,7 @@
 //!   column), uneven time stamps resampled, read in chunks.
 //! - [`fft`]: the discrete Fourier transform (radix-2 and Bluestein, any length).
 //! - [`psd`]: Welch's power spectral density and the plain FFT amplitude spectrum.
-//! - [`identify`](mod@identify): peaks → frequency and damping ratio by half-power bandwidth, a fit of the
+//! - [`identify`](mod@identify) (split by stage: `peaks`, `half_power`, `spectrum_fit`, `decay`): peaks → frequency and damping ratio by half-power bandwidth, a fit of the
 //!   modal spectrum, and a least-squares fit of the free decay, each with an uncertainty.
 //! - [`klipper`]: Klipper's own recommendation reproduced (its shaper table, normalisation,
 //!   frequency scan and selection rules).
@@ -18,6 +18,7 @@ pub mod klipper;
 pub mod psd;
 pub mod recommend;
 pub mod recording;
+pub mod spectrum_file;
 
 pub use identify::{identify, Identification, IdentifiedMode, IdentifyOptions, SignalKind};
 pub use psd::{fft_spectrum, welch, FftOptions, Psd, WelchOptions, WindowKind};
