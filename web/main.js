@@ -5,8 +5,7 @@
 // yet (a link, a reload), a shaper that cannot be designed is left out instead (render).
 import * as lite from '../pkg/page/playground.js';
 import { DEFAULT_STATE, PRESETS, MAX_MODES, MAX_SHAPERS, checkState, clone, toHash, fromHash } from './state.js';
-import { COMMAND_PARAMS, commandFor } from './params.js';
-import { paramInfo, parseParam, formatParam } from './params.js';
+import { COMMAND_PARAMS, commandFor, parseParam, formatParam } from './params.js';
 import { setupMeasure } from './measure.js';
 
 const $ = (id) => document.getElementById(id);
@@ -18,11 +17,13 @@ const COLORS = ['#0072b2', '#d55e00', '#009e73', '#cc79a7'];
 // ("Solved designs", below), fetched when the first one is needed; renderPlayground draws the
 // shapers it hands back.
 const api = lite;
-/** The families always designed by the solver (sampled only with bounds: the error tells). */
-const SOLVED_FAMILIES = new Set(['si', 'direct']);
 
 let state = clone(DEFAULT_STATE);
+/** The library's family table (`families()`): names, titles, parameters with their editors. */
 let familyTable = [];
+/** The families always designed by the solver (`solver: "always"`; a `"whenBounded"` one, sampled,
+ * only with bounds: the error tells). */
+let solvedFamilies = new Set();
 let lastGood = null; // { state, result, left, waiting: the shapers it left out (indices) }
 
 // ---------- small DOM helpers (text only: user text never reaches innerHTML) ----------
@@ -140,16 +141,15 @@ function shaperCard(spec, k) {
   family.addEventListener('change', () => {
     const next = { family: family.value };
     const nextInfo = familyTable.find((f) => f.name === family.value);
-    for (const p of nextInfo?.parameters ?? []) {
-      const d = paramInfo(p, family.value).default;
-      if (d !== undefined) next[p] = d;
+    for (const p of nextInfo?.params ?? []) {
+      if (p.default !== undefined) next[p.name] = structuredClone(p.default);
     }
     state.shapers[k] = next;
     rebuild();
     changed(true);
   });
-  const params = (info?.parameters ?? []).map((name) => {
-    const pinfo = paramInfo(name, spec.family);
+  const params = (info?.params ?? []).map((pinfo) => {
+    const { name } = pinfo;
     if (!(name in spec) && pinfo.default !== undefined && !pinfo.optional) spec[name] = pinfo.default;
     let input;
     if (pinfo.kind === 'select' || pinfo.kind === 'boolean') {
@@ -165,8 +165,10 @@ function shaperCard(spec, k) {
         id: `shaper-${k}-${name}`, type: pinfo.kind === 'numbers' ? 'text' : 'number', step: pinfo.kind === 'integer' ? '1' : 'any',
         value: formatParam(pinfo, spec[name]), dataset: { field: `shapers[${k}].${name}` },
       });
-      if (pinfo.min !== undefined) input.min = String(pinfo.min);
-      if (pinfo.max !== undefined) input.max = String(pinfo.max);
+      // The limits are in the spec's units: a percent field shows them in %.
+      const shown = (x) => formatParam(pinfo.kind === 'percent' ? pinfo : { kind: 'number' }, x);
+      if (pinfo.min !== undefined) input.min = shown(pinfo.min);
+      if (pinfo.max !== undefined) input.max = shown(pinfo.max);
     }
     input.addEventListener('input', () => {
       const v = parseParam(pinfo, input.value);
@@ -174,9 +176,7 @@ function shaperCard(spec, k) {
       else spec[name] = v;
       changed();
     });
-    const f = field(pinfo.label, input);
-    if (pinfo.help) f.append(el('span', { class: 'hint' }, pinfo.help));
-    return f;
+    return field(pinfo.label, input);
   });
   const remove = el('button', { type: 'button', class: 'remove', 'aria-label': `Remove shaper ${k + 1}`, disabled: state.shapers.length <= 1 }, '×');
   remove.addEventListener('click', () => { state.shapers.splice(k, 1); rebuild(); changed(true); });
@@ -540,7 +540,7 @@ function render(st, canvases) {
     if (known?.shaper && !quiet) {
       waiting.push(i);
       awaitingQuiet = true;
-    } else if (known?.pending || (!known && SOLVED_FAMILIES.has(s.family))) waiting.push(i);
+    } else if (known?.pending || (!known && solvedFamilies.has(s.family))) waiting.push(i);
     else kept.push(i);
   });
   if (awaitingQuiet) {
@@ -796,6 +796,7 @@ async function main() {
   const wasmModule = await compileModule('playground_bg.wasm');
   await lite.default({ module_or_path: wasmModule });
   familyTable = api.families();
+  solvedFamilies = new Set(familyTable.filter((f) => f.solver === 'always').map((f) => f.name));
   $('preset').append(...PRESETS.map((p) => el('option', { value: p.id }, p.title)));
   $('preset').addEventListener('change', () => {
     const p = PRESETS.find((x) => x.id === $('preset').value);
