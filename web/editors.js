@@ -71,7 +71,7 @@ function shaperCard(spec, k) {
   });
   const params = (info?.params ?? []).map((pinfo) => {
     const { name } = pinfo;
-    if (!(name in spec) && pinfo.default !== undefined && !pinfo.optional) spec[name] = pinfo.default;
+    if (!(name in spec) && pinfo.default !== undefined && !pinfo.optional) spec[name] = structuredClone(pinfo.default);
     let input;
     if (pinfo.kind === 'select' || pinfo.kind === 'boolean') {
       const options = pinfo.kind === 'boolean' ? ['false', 'true'] : pinfo.options;
