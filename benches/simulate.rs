@@ -1,5 +1,5 @@
 //! Benchmarks (not tests): the streaming shaper's throughput and the exact simulation against
-//! scipy.signal.lsim (run `python3 benches/lsim_scipy.py` side by side; see the README).
+//! scipy.signal.lsim (run `python3 benches/lsim_scipy.py` side by side; see docs/benchmarks.md).
 //!
 //! `cargo bench --bench simulate`
 

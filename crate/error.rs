@@ -46,7 +46,7 @@ pub enum Error {
     /// of the solved families (`si`, `direct`, and `sampled` when an amplitude or increment
     /// bound is active), Cargo feature `solver`. Only builds without that feature return it:
     /// the page's first wasm module, which fetches the module with the solver when it sees
-    /// this error (README, *Shipped size*).
+    /// this error (docs/page-performance.md, *Shipped size*).
     Unavailable {
         /// The field whose value needs the left-out part (`shapers[0]`, say).
         field: String,

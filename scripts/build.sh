@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Builds the release wasm modules and their JS bindings into pkg/ (wasm-bindgen --target web),
-# then shrinks each wasm with npm's binaryen (Debian's wasm-opt 108 breaks it; see README).
+# then shrinks each wasm with npm's binaryen (Debian's wasm-opt 108 breaks it; see docs/building.md).
 #
 # Each wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
 # library with the crate (-Z build-std) at the module's opt-level ("z", or 2 for the page's
 # main thread; below) and LTO, with panic locations left out (-Z location-detail=none; panic
-# messages stay): same code, same results, ~24 KB less gzip (README, *Shipped size*). std's
+# messages stay): same code, same results, ~24 KB less gzip (docs/page-performance.md, *Shipped size*). std's
 # `optimize_for_size` feature would save 7 KB more, but it formats floats (every tick label)
 # with Dragon4 only, not Grisu. Without that toolchain (setup could not install it), or with
 # STABLE=1, it is built by stable Rust.
@@ -24,7 +24,7 @@ if [ "${STABLE:-0}" != 1 ] && sysroot=$(rustup run "$nightly" rustc --print sysr
 fi
 
 # Four modules from one crate, each with the exports of some Cargo features (Cargo.toml):
-#   pkg/input_shaping.js          the whole JavaScript API (README), for programs of your own;
+#   pkg/input_shaping.js          the whole JavaScript API (docs/js-api.md), for programs of your own;
 #   pkg/page/playground.js        what the page calls (js-playground) without the optimisation
 #                                 solver: the solved families (si, direct, bounded sampled)
 #                                 answer "unavailable" (the measured-data worker ranks shapers
@@ -34,7 +34,7 @@ fi
 #   pkg/page/recording.js         what its measured-data worker calls (js-recording), fetched
 #                                 only when a recording is opened.
 # The linker keeps only the code an export reaches, so the page's modules are smaller than the
-# whole API's (README, *Shipped size*). The same sources, the same results.
+# whole API's (docs/page-performance.md, *Shipped size*). The same sources, the same results.
 #
 # The main thread's module (playground) runs every update of the page, so it is optimised for
 # speed within the size budget: opt-level 2 and `wasm-opt -O2`, not "z" and `-Oz`. In

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Bundles and minifies the page's scripts (esbuild) next to its wasm modules, into pkg/page/:
-#   main.js            web/main.js with web/state.js, params.js, measure.js and the
+#   main.js            web/main.js with the modules it imports (page, state, params, dom,
+#                      editors, results, designs, measure) and the
 #                      playground module's glue (index.html loads it);
 #   measure_worker.js  web/measure_worker.js with the recording module's glue and the
 #                      playground module's (it ranks shapers with the page's module, which

@@ -32,7 +32,7 @@ if [ "$have" != "$want" ]; then
 fi
 
 # The shipped wasm is built by a pinned nightly that recompiles the standard library for size
-# (scripts/build.sh; README, *Shipped size*). If it cannot be installed, the build falls back to
+# (scripts/build.sh; docs/page-performance.md, *Shipped size*). If it cannot be installed, the build falls back to
 # the stable toolchain (same code, ~24 KB gzip larger), so a missing nightly never fails a run.
 nightly=$(bash scripts/nightly.sh)
 if ! rustup run "$nightly" rustc --print sysroot >/dev/null 2>&1 \

@@ -144,3 +144,38 @@ fn bad_input_to_solved_families_is_reported_at_its_field() {
         assert_eq!(e.field(), Some(field), "{json}: {e}");
     }
 }
+
+/// The family table's `solver` column is what a build without the solver does: from each row's
+/// editor defaults, a `never` family designs, an `always` family is unavailable, and the
+/// `whenBounded` one (sampled, unbounded by default) designs; bounded, it is unavailable
+/// (`solved_families_are_unavailable_with_a_message`).
+#[test]
+fn family_table_solver_column_holds_without_the_solver() {
+    use input_shaping::design::{ParamDefault, ParamKind, Solver, FAMILIES};
+    let mode = Mode::new(2.0, 0.05).unwrap();
+    for row in FAMILIES {
+        let mut spec = serde_json::Map::new();
+        spec.insert("family".into(), row.name.into());
+        for p in row.params {
+            let value = match (p.kind, p.default) {
+                (_, None) => continue,
+                // A spec's counts are whole numbers.
+                (ParamKind::Integer, Some(ParamDefault::Number(x))) => (x as u64).into(),
+                (_, Some(d)) => serde_json::to_value(d).unwrap(),
+            };
+            spec.insert(p.name.into(), value);
+        }
+        let spec: ShaperSpec = serde_json::from_value(spec.into()).unwrap();
+        let designed = design_for(&spec, &[mode]);
+        match row.solver {
+            Solver::Always => assert!(
+                matches!(designed, Err(Error::Unavailable { .. })),
+                "{}: {designed:?}",
+                row.name
+            ),
+            Solver::Never | Solver::WhenBounded => {
+                assert!(designed.is_ok(), "{}: {designed:?}", row.name)
+            }
+        }
+    }
+}

@@ -2,7 +2,12 @@
 //!
 //! A spec is a JSON-like object `{ family, modes: [{ frequencyHz, damping }], …parameters }`.
 //! Each family lives in its own file and reads like the paper it comes from; adding one is a
-//! function there plus a row in [`FAMILIES`] and a variant of [`ShaperSpec`].
+//! function there, a variant of [`ShaperSpec`] with its name in [`ShaperSpec::name`] and its arm
+//! in the dispatch below (both exhaustive matches: the compiler points at them), and a row in
+//! [`FAMILIES`] (`family.rs`) with its parameters' labels, limits and defaults, from which the
+//! JavaScript `families()`, the page's editors and `docs/families.md` are made.
+//! `tests/families.rs` checks that every row parses to its variant and designs from its
+//! defaults.
 //!
 //! For several modes, single-mode families are designed per mode and convolved
 //! (Singer & Seering 1988 §2.3). Every design is checked against its guarantee with an
@@ -17,6 +22,7 @@ pub mod zero_vibration;
 pub mod custom;
 pub(crate) mod equations;
 pub mod extra_insensitive;
+mod family;
 pub mod modified;
 pub mod negative;
 
@@ -24,6 +30,8 @@ use crate::error::{Error, Result};
 use crate::mode::{Mode, ModeSpec};
 use crate::shaper::Shaper;
 use serde::{Deserialize, Serialize};
+
+pub use family::{FamilyInfo, ParamDefault, ParamInfo, ParamKind, Solver, FAMILIES};
 
 crate::tagged::tagged_enum! {
     tag = "family", rename_all = "lowercase", mirror = shaper_spec_serde;
@@ -192,178 +200,6 @@ impl<'de> Deserialize<'de> for DesignRequest {
         Ok(Self { modes, shaper })
     }
 }
-
-/// One row of the family table: what the family is called and what it promises.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(rename_all = "camelCase")]
-pub struct FamilyInfo {
-    /// The `family` string of a spec.
-    pub name: &'static str,
-    /// A short human name.
-    pub title: &'static str,
-    /// What a shaper of this family guarantees.
-    pub guarantee: &'static str,
-    /// Parameters besides `modes`, as written in a spec.
-    pub parameters: &'static [&'static str],
-    /// Where it comes from.
-    pub source: &'static str,
-}
-
-/// Every family [`design`] accepts.
-pub const FAMILIES: &[FamilyInfo] = &[
-    FamilyInfo {
-        name: "zv",
-        title: "ZV",
-        guarantee: "V = 0 at each mode; shortest positive shaper",
-        parameters: &[],
-        source: "Singer & Seering 1988 eq. 6; Singhose 2009 eqs. 14-15",
-    },
-    FamilyInfo {
-        name: "zvd",
-        title: "ZVD",
-        guarantee: "V = 0 and dV/dω = 0 at each mode",
-        parameters: &[],
-        source: "Singer & Seering 1988 eq. 7; Singhose 2009 eq. 17",
-    },
-    FamilyInfo {
-        name: "zvdd",
-        title: "ZVDD",
-        guarantee: "V = 0 and two derivatives zero at each mode",
-        parameters: &[],
-        source: "Singer & Seering 1988 eq. 8",
-    },
-    FamilyInfo {
-        name: "zvdn",
-        title: "ZV-Dⁿ",
-        guarantee: "V = 0 and n derivatives zero at each mode",
-        parameters: &["derivatives"],
-        source: "Singer & Seering 1988 §2.2 (binomial form)",
-    },
-    FamilyInfo {
-        name: "sampled",
-        title: "Sampled (t = iT)",
-        guarantee: "V = 0 at the mode with `derivatives` derivatives (default 1), impulses at \
-                    t = iT, ramp delay m·T if asked, amplitude/increment bounds; least control \
-                    error J_q; one mode",
-        parameters: &[
-            "periodS",
-            "impulses",
-            "delaySamples",
-            "weight",
-            "derivatives",
-            "plantGain",
-            "objective",
-            "amplitudeMin",
-            "amplitudeMax",
-            "incrementMin",
-            "incrementMax",
-        ],
-        source: "Kamel, Lange & Hirzinger, eqs. 4-25",
-    },
-    FamilyInfo {
-        name: "ei",
-        title: "EI",
-        guarantee: "V = vtol with zero slope at each mode, V = 0 either side; exact with damping",
-        parameters: &["vtol"],
-        source: "Singhose 2009 §3.1, Fig. 7; solved by Newton from the ζ = 0 closed form",
-    },
-    FamilyInfo {
-        name: "ei2",
-        title: "Two-hump EI",
-        guarantee: "two humps V = vtol around each mode, V = 0 at the mode and beyond the humps",
-        parameters: &["vtol"],
-        source: "Singhose 2009 §3.1, Fig. 11; Singhose et al. 1997 (multi-hump)",
-    },
-    FamilyInfo {
-        name: "ei3",
-        title: "Three-hump EI",
-        guarantee: "three humps V = vtol (the middle one at each mode), four zeros",
-        parameters: &["vtol"],
-        source: "Singhose 2009 §3.1, Fig. 11; Singhose et al. 1997 (multi-hump)",
-    },
-    FamilyInfo {
-        name: "eihump",
-        title: "n-hump EI",
-        guarantee: "n humps V = vtol with zero slope, n + 1 zeros around them",
-        parameters: &["humps", "vtol"],
-        source: "Singhose 2009 §3.1; Chebyshev closed form at ζ = 0, Newton with damping",
-    },
-    FamilyInfo {
-        name: "mzv",
-        title: "MZV (Klipper)",
-        guarantee: "V = 0 at each mode; second zero near 5/3 of it; 0.75 damped period",
-        parameters: &[],
-        source: "Klipper klippy/extras/shaper_defs.py get_mzv_shaper",
-    },
-    FamilyInfo {
-        name: "umzv",
-        title: "UM-ZV",
-        guarantee: "V = 0 at each mode; amplitudes +1, -1, +1 (on/off command)",
-        parameters: &[],
-        source: "Singhose 2009 §5; Singhose, Seering & Singer 1997 (negative shapers)",
-    },
-    FamilyInfo {
-        name: "umzvd",
-        title: "UM-ZVD",
-        guarantee: "V = 0 and dV/dω = 0 at each mode; amplitudes ±1",
-        parameters: &[],
-        source: "Singhose 2009 §5; Singhose, Seering & Singer 1997 (negative shapers)",
-    },
-    FamilyInfo {
-        name: "umei",
-        title: "UM-EI",
-        guarantee: "hump V = vtol at the mode, zeros either side; amplitudes ±1",
-        parameters: &["vtol"],
-        source: "Singhose 2009 §5; Vaughan, Yano & Singhose 2009",
-    },
-    FamilyInfo {
-        name: "bangbang",
-        title: "Time-optimal bang-bang",
-        guarantee: "rest-to-rest move of `distance`, V = 0 at the mode; amplitudes sum to 0",
-        parameters: &["distance", "maxAcceleration"],
-        source: "Singhose 2009 §5, Fig. 13",
-    },
-    FamilyInfo {
-        name: "onoff",
-        title: "Fuel-efficient on/off",
-        guarantee: "rest-to-rest move with a coast, no vibration while coasting or after",
-        parameters: &["distance", "maxAcceleration", "coastTime"],
-        source: "Singhose 2009 §5, Fig. 14",
-    },
-    FamilyInfo {
-        name: "custom",
-        title: "Custom",
-        guarantee: "none beyond a valid impulse sequence (modes are not used)",
-        parameters: &["impulses", "normalize"],
-        source: "your own",
-    },
-    FamilyInfo {
-        name: "si",
-        title: "SI (specified insensitivity)",
-        guarantee: "V ≤ vtol over the band (whole band, verified densely) or at the sampled \
-                    frequencies; shortest such shaper",
-        parameters: &[
-            "vtol",
-            "insensitivity",
-            "bandHz",
-            "dampingRange",
-            "sampleFrequenciesHz",
-            "vtolProfile",
-            "amplitudeMin",
-            "amplitudeMax",
-            "maxImpulses",
-            "maxDuration",
-        ],
-        source: "Singhose 2009 eq. 18, Figs. 8-11; Pelaez & Singhose 2002 eqs. 6-7",
-    },
-    FamilyInfo {
-        name: "direct",
-        title: "Direct multi-mode ZV / ZVD",
-        guarantee: "V = 0 and n derivatives zero at every mode at once; shortest such shaper",
-        parameters: &["derivatives", "amplitudeMin", "amplitudeMax", "maxDuration"],
-        source: "Singer & Seering 1988 §2.3; Singhose 2009 §4, Fig. 12",
-    },
-];
 
 /// What a designed shaper promises, checked by [`verify`] before it is returned.
 #[derive(Debug, Clone, PartialEq)]

@@ -65,6 +65,9 @@ use serde::{Deserialize, Serialize};
 
 /// Most impulses a sampled shaper may have (the KKT system is dense, O(n³) to solve).
 pub const MAX_IMPULSES: usize = 256;
+/// Fewest impulses a sampled shaper may have: one per row of eq. 13, 3 without derivatives and
+/// without a prescribed delay (2 more per derivative, 1 more with `delaySamples`).
+pub const MIN_IMPULSES: usize = 3;
 /// Most derivative conditions (rows weighted by tᵢ, …, tᵢᵏ) accepted.
 pub const MAX_DERIVATIVES: u32 = 3;
 /// The paper's weight, Q = 0.1 · I (Kamel et al. Fig. 3).
@@ -247,7 +250,9 @@ impl Problem {
                 limit: f64::from(MAX_DERIVATIVES),
             });
         }
-        let rows = 3 + 2 * spec.derivatives as usize + usize::from(spec.delay_samples.is_some());
+        let rows = MIN_IMPULSES
+            + 2 * spec.derivatives as usize
+            + usize::from(spec.delay_samples.is_some());
         let n = count("impulses", spec.impulses, rows, MAX_IMPULSES).map_err(|e| match e {
             Error::InvalidInput { field, reason } => Error::InvalidInput {
                 field,
