@@ -137,8 +137,40 @@ fn pair(field: &str, p: [f64; 2], strict: bool) -> Result<(f64, f64)> {
 
 /// The solver problem an SI spec describes, and the bound its result must meet.
 fn problem(spec: &SiSpec, modes: &[Mode]) -> Result<Problem> {
-    // Tolerance: constant `vtol`, or the profile.
-    let tolerance = match &spec.vtol_profile {
+    let tolerance = tolerance(spec)?;
+    check_amplitudes_and_limits(spec)?;
+    let damping_range = damping_range(spec)?;
+    let bands = bands(spec, modes, damping_range)?;
+    let mut p = Problem {
+        zeros: Vec::new(),
+        limits: Vec::new(),
+        bands: Vec::new(),
+        amplitude_min: spec.amplitude_min,
+        amplitude_max: spec.amplitude_max,
+        max_duration: spec.max_duration,
+    };
+    match &spec.sample_frequencies_hz {
+        Some(samples) => {
+            p.limits = sampled_limits(samples, &bands, damping_range, modes, &tolerance)?;
+        }
+        None => {
+            for (lo, hi, zl, zh) in bands {
+                p.bands.push(Band {
+                    from_hz: lo,
+                    to_hz: hi,
+                    damping_from: zl,
+                    damping_to: zh,
+                    tolerance: tolerance.clone(),
+                });
+            }
+        }
+    }
+    Ok(p)
+}
+
+/// The tolerance: constant `vtol`, or the profile.
+fn tolerance(spec: &SiSpec) -> Result<Tolerance> {
+    Ok(match &spec.vtol_profile {
         Some(points) => Tolerance::profile(points.iter().map(|p| (p[0], p[1])).collect())?,
         None => {
             positive("vtol", spec.vtol)?;
@@ -153,7 +185,11 @@ fn problem(spec: &SiSpec, modes: &[Mode]) -> Result<Problem> {
             }
             Tolerance::constant(spec.vtol)?
         }
-    };
+    })
+}
+
+/// Checks the amplitude bounds, `maxDuration` and `maxImpulses`.
+fn check_amplitudes_and_limits(spec: &SiSpec) -> Result<()> {
     finite("amplitudeMin", spec.amplitude_min)?;
     finite("amplitudeMax", spec.amplitude_max)?;
     if spec.amplitude_max <= 0.0 {
@@ -177,7 +213,12 @@ fn problem(spec: &SiSpec, modes: &[Mode]) -> Result<Problem> {
     if let Some(n) = spec.max_impulses {
         crate::error::count("maxImpulses", n, 1, MAX_IMPULSES_PARAMETER)?;
     }
-    let damping_range = match spec.damping_range {
+    Ok(())
+}
+
+/// `dampingRange`, checked.
+fn damping_range(spec: &SiSpec) -> Result<Option<(f64, f64)>> {
+    Ok(match spec.damping_range {
         Some(r) => {
             let (lo, hi) = pair("dampingRange", r, false)?;
             crate::vibration::damping_ratio("dampingRange[0]", lo)?;
@@ -185,12 +226,19 @@ fn problem(spec: &SiSpec, modes: &[Mode]) -> Result<Problem> {
             Some((lo, hi))
         }
         None => None,
-    };
+    })
+}
+
+/// The bands, one per mode (insensitivity) or the one given (`bandHz`), each (from Hz, to Hz,
+/// damping from, damping to); none when only sample frequencies are given.
+fn bands(
+    spec: &SiSpec,
+    modes: &[Mode],
+    damping_range: Option<(f64, f64)>,
+) -> Result<Vec<(f64, f64, f64, f64)>> {
     let dampings_of =
         |mode: &Mode| -> (f64, f64) { damping_range.unwrap_or((mode.damping(), mode.damping())) };
-
-    // The bands, one per mode (insensitivity) or the one given.
-    let bands: Vec<(f64, f64, f64, f64)> = match (spec.insensitivity, spec.band_hz) {
+    Ok(match (spec.insensitivity, spec.band_hz) {
         (Some(_), Some(_)) => {
             return Err(Error::invalid(
                 "bandHz",
@@ -243,76 +291,62 @@ fn problem(spec: &SiSpec, modes: &[Mode]) -> Result<Problem> {
             }
             Vec::new()
         }
-    };
+    })
+}
 
-    let mut p = Problem {
-        zeros: Vec::new(),
-        limits: Vec::new(),
-        bands: Vec::new(),
-        amplitude_min: spec.amplitude_min,
-        amplitude_max: spec.amplitude_max,
-        max_duration: spec.max_duration,
-    };
-    match &spec.sample_frequencies_hz {
-        Some(samples) => {
-            crate::error::count("sampleFrequenciesHz", samples.len(), 1, MAX_SAMPLES)?;
-            for (i, &f) in samples.iter().enumerate() {
-                let field = format!("sampleFrequenciesHz[{i}]");
-                finite(&field, f)?;
-                if !(crate::mode::MIN_FREQUENCY_HZ..=crate::mode::MAX_FREQUENCY_HZ).contains(&f) {
-                    return Err(Error::invalid(
-                        field,
-                        format!(
-                            "must lie between {} and {} Hz, got {f}",
-                            crate::mode::MIN_FREQUENCY_HZ,
-                            crate::mode::MAX_FREQUENCY_HZ
-                        ),
-                    ));
-                }
-                if !bands.is_empty()
-                    && !bands
-                        .iter()
-                        .any(|b| f >= b.0 * (1.0 - 1e-12) && f <= b.1 * (1.0 + 1e-12))
-                {
-                    return Err(Error::invalid(
-                        field,
-                        format!(
-                            "{f} Hz lies outside the band the insensitivity or bandHz describes"
-                        ),
-                    ));
-                }
-            }
-            // Each sample at each mode's damping (or at the ends and middle of dampingRange).
-            let mut dampings: Vec<f64> = match damping_range {
-                Some((lo, hi)) if hi > lo => vec![lo, 0.5 * (lo + hi), hi],
-                Some((lo, _)) => vec![lo],
-                None => modes.iter().map(|m| m.damping()).collect(),
-            };
-            dampings.sort_by(f64::total_cmp);
-            dampings.dedup();
-            for &f in samples {
-                for &z in &dampings {
-                    p.limits.push(Limit {
-                        frequency_hz: f,
-                        damping: z,
-                        vtol: tolerance.at(f),
-                    });
-                }
-            }
+/// The limits of `sampleFrequenciesHz` (each checked, and inside the bands if there are any):
+/// each sample at each mode's damping (or at the ends and middle of `dampingRange`).
+fn sampled_limits(
+    samples: &[f64],
+    bands: &[(f64, f64, f64, f64)],
+    damping_range: Option<(f64, f64)>,
+    modes: &[Mode],
+    tolerance: &Tolerance,
+) -> Result<Vec<Limit>> {
+    let mut limits = Vec::new();
+    crate::error::count("sampleFrequenciesHz", samples.len(), 1, MAX_SAMPLES)?;
+    for (i, &f) in samples.iter().enumerate() {
+        let field = format!("sampleFrequenciesHz[{i}]");
+        finite(&field, f)?;
+        if !(crate::mode::MIN_FREQUENCY_HZ..=crate::mode::MAX_FREQUENCY_HZ).contains(&f) {
+            return Err(Error::invalid(
+                field,
+                format!(
+                    "must lie between {} and {} Hz, got {f}",
+                    crate::mode::MIN_FREQUENCY_HZ,
+                    crate::mode::MAX_FREQUENCY_HZ
+                ),
+            ));
         }
-        None => {
-            for (lo, hi, zl, zh) in bands {
-                p.bands.push(Band {
-                    from_hz: lo,
-                    to_hz: hi,
-                    damping_from: zl,
-                    damping_to: zh,
-                    tolerance: tolerance.clone(),
-                });
-            }
+        if !bands.is_empty()
+            && !bands
+                .iter()
+                .any(|b| f >= b.0 * (1.0 - 1e-12) && f <= b.1 * (1.0 + 1e-12))
+        {
+            return Err(Error::invalid(
+                field,
+                format!("{f} Hz lies outside the band the insensitivity or bandHz describes"),
+            ));
         }
     }
-    Ok(p)
+    // Each sample at each mode's damping (or at the ends and middle of dampingRange).
+    let mut dampings: Vec<f64> = match damping_range {
+        Some((lo, hi)) if hi > lo => vec![lo, 0.5 * (lo + hi), hi],
+        Some((lo, _)) => vec![lo],
+        None => modes.iter().map(|m| m.damping()).collect(),
+    };
+    dampings.sort_by(f64::total_cmp);
+    dampings.dedup();
+    for &f in samples {
+        for &z in &dampings {
+            limits.push(Limit {
+                frequency_hz: f,
+                damping: z,
+                vtol: tolerance.at(f),
+            });
+        }
+    }
+    Ok(limits)
 }
 
 /// Designs an SI shaper for `modes`; returns it with the guarantee to verify: V ≤ Vtol at every

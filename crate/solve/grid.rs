@@ -60,101 +60,19 @@ pub(crate) fn solve_on_times(
     let t_end = times[n_amp - 1];
     let has_level = !limits.is_empty();
     let n = n_amp + usize::from(has_level);
-    let level_col = n_amp;
 
-    // Triplets (row, col, value) of A in A x + z = b, and b, in cone order.
-    let mut rows: Vec<usize> = Vec::new();
-    let mut cols: Vec<usize> = Vec::new();
-    let mut vals: Vec<f64> = Vec::new();
-    let mut b: Vec<f64> = Vec::new();
-    let mut push = |r: usize, c: usize, v: f64, rows: &mut Vec<usize>| {
-        if v != 0.0 {
-            rows.push(r);
-            cols.push(c);
-            vals.push(v);
-        }
-    };
-
-    // Zero cone: Σ A = 1, then the moment equalities.
-    let mut row = 0;
-    for k in 0..n_amp {
-        push(row, k, 1.0, &mut rows);
-    }
-    b.push(1.0);
-    row += 1;
-    for zero in &problem.zeros {
-        for order in 0..=zero.derivatives {
-            let mut coeffs = vec![[0.0; 2]; n_amp];
-            for (k, &t) in times.iter().enumerate() {
-                let p = impulse_phasor(t, t_end, zero.omega, zero.zeta);
-                let w = if order == 0 {
-                    1.0
-                } else {
-                    t.powi(order as i32)
-                };
-                coeffs[k] = [w * p[0], w * p[1]];
-            }
-            for part in 0..2 {
-                let scale = coeffs.iter().map(|c| c[part].abs()).fold(0.0_f64, f64::max);
-                if scale == 0.0 {
-                    continue; // e.g. the sine part at ω_d t = 0 only
-                }
-                for (k, c) in coeffs.iter().enumerate() {
-                    push(row, k, c[part] / scale, &mut rows);
-                }
-                b.push(0.0);
-                row += 1;
-            }
-        }
-    }
-    let n_zero = row;
-
-    // Nonnegative cone: bounds and increments. With A ≥ 0 and Σ A = 1, A ≤ 1 holds anyway, so
-    // an upper bound ≥ 1 is left out.
-    let upper = !(problem.amplitude_min >= 0.0 && problem.amplitude_max >= 1.0);
-    for k in 0..n_amp {
-        push(row, k, -1.0, &mut rows); // A_k − A_min ≥ 0
-        b.push(-problem.amplitude_min);
-        row += 1;
-        if upper {
-            push(row, k, 1.0, &mut rows); // A_max − A_k ≥ 0
-            b.push(problem.amplitude_max);
-            row += 1;
-        }
-    }
-    if let Some(d) = increment_max {
-        for k in 1..n_amp {
-            push(row, k, 1.0, &mut rows);
-            push(row, k - 1, -1.0, &mut rows);
-            b.push(d);
-            row += 1;
-            push(row, k, -1.0, &mut rows);
-            push(row, k - 1, 1.0, &mut rows);
-            b.push(d);
-            row += 1;
-        }
-    }
-    let n_nonneg = row - n_zero;
-
-    // Second-order cones: (Vtolⱼ s, Σ Aₖ pⱼ(tₖ)).
-    for limit in limits {
-        push(row, level_col, -limit.vtol, &mut rows);
-        b.push(0.0);
-        row += 1;
-        let phasors: Vec<[f64; 2]> = times
-            .iter()
-            .map(|&t| impulse_phasor(t, t_end, limit.omega, limit.zeta))
-            .collect();
-        for part in 0..2 {
-            for (k, p) in phasors.iter().enumerate() {
-                push(row, k, -p[part], &mut rows);
-            }
-            b.push(0.0);
-            row += 1;
-        }
-    }
-    let m = row;
-    if vals.iter().chain(b.iter()).any(|v| !v.is_finite()) {
+    let mut program = Program::default();
+    program.zero_cone(problem, times);
+    let n_zero = program.row;
+    program.nonnegative_cone(problem, n_amp, increment_max);
+    let n_nonneg = program.row - n_zero;
+    program.second_order_cones(limits, times);
+    if program
+        .vals
+        .iter()
+        .chain(program.b.iter())
+        .any(|v| !v.is_finite())
+    {
         return Err(Error::invalid(
             "modes",
             "the design program has non-finite coefficients (frequencies or times out of range)",
@@ -163,60 +81,193 @@ pub(crate) fn solve_on_times(
 
     let mut q = vec![0.0; n];
     if has_level {
-        q[level_col] = 1.0;
+        q[n_amp] = 1.0;
     } else if t_end > 0.0 {
         for (k, &t) in times.iter().enumerate() {
             q[k] = t / t_end;
         }
     }
-    let p = CscMatrix::zeros((n, n));
-    let a = CscMatrix::new_from_triplets(m, n, rows, cols, vals);
     let mut cones = vec![SupportedConeT::ZeroConeT(n_zero)];
     if n_nonneg > 0 {
         cones.push(SupportedConeT::NonnegativeConeT(n_nonneg));
     }
     cones.extend(limits.iter().map(|_| SupportedConeT::SecondOrderConeT(3)));
-
-    let settings = DefaultSettings {
-        verbose: false,
-        max_iter: MAX_SOLVER_ITERATIONS,
-        presolve_enable: false,
-        tol_gap_abs: tolerance,
-        tol_gap_rel: tolerance,
-        tol_feas: tolerance,
-        iterative_refinement_max_iter: 3,
-        ..DefaultSettings::default()
+    let Some(x) = program.solve(n, &q, &cones, tolerance)? else {
+        return Ok(None);
     };
-    let Ok(mut solver) = DefaultSolver::new(&p, &q, &a, &b, &cones, settings) else {
-        return Err(Error::Infeasible {
-            reason: "the design program could not be set up".into(),
-        });
-    };
-    solver.solve();
-    let solution = &solver.solution;
-    match solution.status {
-        SolverStatus::Solved => {}
-        // "Almost" is the solver's reduced accuracy (~1e-4), useless when asked for exactness.
-        SolverStatus::AlmostSolved if tolerance > EXACT_TOLERANCE => {}
-        _ => return Ok(None),
-    }
-    let amplitudes = solution.x[..n_amp].to_vec();
+    let amplitudes = x[..n_amp].to_vec();
     if amplitudes.iter().any(|a| !a.is_finite()) {
         return Ok(None);
     }
     let level = if has_level {
-        // Recompute the level from the amplitudes rather than trusting the solver's s.
-        let imps: Vec<crate::shaper::Impulse> = times
-            .iter()
-            .zip(&amplitudes)
-            .map(|(&time, &amplitude)| crate::shaper::Impulse { time, amplitude })
-            .collect();
-        limits
-            .iter()
-            .map(|l| crate::vibration::vibration_rad(&imps, l.omega, l.zeta) / l.vtol)
-            .fold(0.0_f64, f64::max)
+        level(times, &amplitudes, limits)
     } else {
         0.0
     };
     Ok(Some(Outcome { amplitudes, level }))
+}
+
+/// The program's constraints A x + z = b, z in the cones: the triplets (row, col, value) of A
+/// and b, in cone order. The variables are the amplitudes, then the level s (with limits).
+#[derive(Default)]
+struct Program {
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    vals: Vec<f64>,
+    b: Vec<f64>,
+    /// The next row.
+    row: usize,
+}
+
+impl Program {
+    /// A[row, col] = `value` in the current row (zeros are left out).
+    fn push(&mut self, col: usize, value: f64) {
+        if value != 0.0 {
+            self.rows.push(self.row);
+            self.cols.push(col);
+            self.vals.push(value);
+        }
+    }
+
+    /// Ends the current row with b = `rhs`.
+    fn end_row(&mut self, rhs: f64) {
+        self.b.push(rhs);
+        self.row += 1;
+    }
+
+    /// Zero cone: Σ A = 1, then the moment equalities.
+    fn zero_cone(&mut self, problem: &NormalizedProblem, times: &[f64]) {
+        let n_amp = times.len();
+        let t_end = times[n_amp - 1];
+        for k in 0..n_amp {
+            self.push(k, 1.0);
+        }
+        self.end_row(1.0);
+        for zero in &problem.zeros {
+            for order in 0..=zero.derivatives {
+                let mut coeffs = vec![[0.0; 2]; n_amp];
+                for (k, &t) in times.iter().enumerate() {
+                    let p = impulse_phasor(t, t_end, zero.omega, zero.zeta);
+                    let w = if order == 0 {
+                        1.0
+                    } else {
+                        t.powi(order as i32)
+                    };
+                    coeffs[k] = [w * p[0], w * p[1]];
+                }
+                for part in 0..2 {
+                    let scale = coeffs.iter().map(|c| c[part].abs()).fold(0.0_f64, f64::max);
+                    if scale == 0.0 {
+                        continue; // e.g. the sine part at ω_d t = 0 only
+                    }
+                    for (k, c) in coeffs.iter().enumerate() {
+                        self.push(k, c[part] / scale);
+                    }
+                    self.end_row(0.0);
+                }
+            }
+        }
+    }
+
+    /// Nonnegative cone: bounds and increments. With A ≥ 0 and Σ A = 1, A ≤ 1 holds anyway,
+    /// so an upper bound ≥ 1 is left out.
+    fn nonnegative_cone(
+        &mut self,
+        problem: &NormalizedProblem,
+        n_amp: usize,
+        increment_max: Option<f64>,
+    ) {
+        let upper = !(problem.amplitude_min >= 0.0 && problem.amplitude_max >= 1.0);
+        for k in 0..n_amp {
+            self.push(k, -1.0); // A_k − A_min ≥ 0
+            self.end_row(-problem.amplitude_min);
+            if upper {
+                self.push(k, 1.0); // A_max − A_k ≥ 0
+                self.end_row(problem.amplitude_max);
+            }
+        }
+        if let Some(d) = increment_max {
+            for k in 1..n_amp {
+                self.push(k, 1.0);
+                self.push(k - 1, -1.0);
+                self.end_row(d);
+                self.push(k, -1.0);
+                self.push(k - 1, 1.0);
+                self.end_row(d);
+            }
+        }
+    }
+
+    /// Second-order cones: (Vtolⱼ s, Σ Aₖ pⱼ(tₖ)), the level s in the column after the
+    /// amplitudes.
+    fn second_order_cones(&mut self, limits: &[NormalizedLimit], times: &[f64]) {
+        let t_end = times[times.len() - 1];
+        let level_col = times.len();
+        for limit in limits {
+            self.push(level_col, -limit.vtol);
+            self.end_row(0.0);
+            let phasors: Vec<[f64; 2]> = times
+                .iter()
+                .map(|&t| impulse_phasor(t, t_end, limit.omega, limit.zeta))
+                .collect();
+            for part in 0..2 {
+                for (k, p) in phasors.iter().enumerate() {
+                    self.push(k, -p[part]);
+                }
+                self.end_row(0.0);
+            }
+        }
+    }
+
+    /// Minimises q·x over the `n` variables subject to the constraints in `cones`. `Ok(None)`
+    /// when the solver finds no solution to the accuracy asked for.
+    fn solve(
+        self,
+        n: usize,
+        q: &[f64],
+        cones: &[SupportedConeT<f64>],
+        tolerance: f64,
+    ) -> Result<Option<Vec<f64>>> {
+        let p = CscMatrix::zeros((n, n));
+        let a = CscMatrix::new_from_triplets(self.row, n, self.rows, self.cols, self.vals);
+        let settings = DefaultSettings {
+            verbose: false,
+            max_iter: MAX_SOLVER_ITERATIONS,
+            presolve_enable: false,
+            tol_gap_abs: tolerance,
+            tol_gap_rel: tolerance,
+            tol_feas: tolerance,
+            iterative_refinement_max_iter: 3,
+            ..DefaultSettings::default()
+        };
+        let Ok(mut solver) = DefaultSolver::new(&p, q, &a, &self.b, cones, settings) else {
+            return Err(Error::Infeasible {
+                reason: "the design program could not be set up".into(),
+            });
+        };
+        solver.solve();
+        let solution = &solver.solution;
+        match solution.status {
+            SolverStatus::Solved => {}
+            // "Almost" is the solver's reduced accuracy (~1e-4), useless when asked for
+            // exactness.
+            SolverStatus::AlmostSolved if tolerance > EXACT_TOLERANCE => {}
+            _ => return Ok(None),
+        }
+        Ok(Some(solution.x.clone()))
+    }
+}
+
+/// The level of the amplitudes: max V/Vtol over the limits, recomputed from the amplitudes
+/// rather than trusting the solver's s.
+fn level(times: &[f64], amplitudes: &[f64], limits: &[NormalizedLimit]) -> f64 {
+    let imps: Vec<crate::shaper::Impulse> = times
+        .iter()
+        .zip(amplitudes)
+        .map(|(&time, &amplitude)| crate::shaper::Impulse { time, amplitude })
+        .collect();
+    limits
+        .iter()
+        .map(|l| crate::vibration::vibration_rad(&imps, l.omega, l.zeta) / l.vtol)
+        .fold(0.0_f64, f64::max)
 }

@@ -17,7 +17,9 @@
 //! back to the (feasible, slightly longer) grid solution.
 
 use super::scan::{band_peaks, Peak};
-use super::{clusters, ratio, Cluster, GridSolution, NormalizedProblem, CHECK_TOLERANCE};
+use super::{
+    clusters, ratio, Cluster, GridSolution, NormalizedLimit, NormalizedProblem, CHECK_TOLERANCE,
+};
 use crate::shaper::Impulse;
 use crate::vibration::{impulse_phasor, vibration_moment};
 use nalgebra::{DMatrix, DVector};
@@ -710,25 +712,71 @@ fn polish_from(
     raw: &[Impulse],
     start: Vec<Impulse>,
 ) -> Option<Vec<Impulse>> {
-    let raw = raw.to_vec();
+    let candidates = candidates(norm, raw);
+    let top = candidates.first().map_or(0.0, |c| c.grid_ratio);
+    let mut active = initial_active(norm, start, &candidates, top);
+    let mut retry = Retry {
+        dropped_from: None,
+        drops: 0,
+    };
+    for _ in 0..MAX_ACTIVE_SET_ROUNDS {
+        // (More equations than unknowns is allowed: degenerate but consistent systems, e.g.
+        // a single-mode ZVD that also cancels a mode at an odd multiple of its frequency, are
+        // solved by Gauss–Newton in the least-squares sense; inconsistent ones fail there.)
+        if active.impulses.len() < 2 {
+            return None;
+        }
+        let (setup, y0) = build(norm, &active);
+        let Some(solved) = sqp(&setup, y0) else {
+            if retry.restructure(norm, &mut active, &candidates, top) {
+                continue;
+            }
+            return None;
+        };
+        let imps = setup.impulses(&solved.y);
+        if merge_coincident(&mut active, &imps, &setup, &solved.y)
+            || fix_amplitude(norm, &mut active, &imps, &setup, &solved.y)
+            || release_wrong_sign(&mut active, &imps, &setup, &solved)
+        {
+            continue;
+        }
+        // Constraints the result violates: add the worst one.
+        if let Some(spec) = worst_violation(norm, &imps) {
+            active.impulses = imps;
+            update_points(&mut active, &setup, &solved.y);
+            // Free coordinates of an existing point may have slid onto the new one's place.
+            active.points.push(spec);
+            continue;
+        }
+        return Some(imps);
+    }
+    None
+}
 
-    // Candidate active points, ranked by V/Vtol on the grid solution.
+/// A sampled limit as an active point (fixed frequency and damping), with its V/Vtol `ratio`.
+fn limit_point(l: &NormalizedLimit, ratio: f64) -> PointSpec {
+    PointSpec {
+        omega: l.omega,
+        zeta: l.zeta,
+        omega_free: false,
+        zeta_free: false,
+        vtol: Vtol::Constant(l.vtol),
+        bounds: (l.omega, l.omega, l.zeta, l.zeta),
+        grid_ratio: ratio,
+    }
+}
+
+/// Candidate active points (the sampled limits and the bands' peaks), ranked by V/Vtol on the
+/// grid solution `raw`, highest first.
+fn candidates(norm: &NormalizedProblem, raw: &[Impulse]) -> Vec<PointSpec> {
     let mut candidates: Vec<PointSpec> = norm
         .limits
         .iter()
-        .map(|l| PointSpec {
-            omega: l.omega,
-            zeta: l.zeta,
-            omega_free: false,
-            zeta_free: false,
-            vtol: Vtol::Constant(l.vtol),
-            bounds: (l.omega, l.omega, l.zeta, l.zeta),
-            grid_ratio: ratio(&raw, l.omega, l.zeta, l.vtol),
-        })
+        .map(|l| limit_point(l, ratio(raw, l.omega, l.zeta, l.vtol)))
         .collect();
     for (b, band) in norm.bands.iter().enumerate() {
         candidates.extend(
-            band_peaks(&raw, band, b, None)
+            band_peaks(raw, band, b, None)
                 .iter()
                 .map(|p| PointSpec::from_peak(norm, p)),
         );
@@ -736,8 +784,17 @@ fn polish_from(
     crate::sort::sort_by(&mut candidates, |a, b| {
         b.grid_ratio.total_cmp(&a.grid_ratio)
     });
-    let top = candidates.first().map_or(0.0, |c| c.grid_ratio);
+    candidates
+}
 
+/// The starting structure: amplitudes near a bound pinned to it, and the candidates near the
+/// top ratio `top` active (while there is freedom for them).
+fn initial_active(
+    norm: &NormalizedProblem,
+    start: Vec<Impulse>,
+    candidates: &[PointSpec],
+    top: f64,
+) -> Active {
     let range = norm.amplitude_max - norm.amplitude_min;
     let mut active = Active {
         bounds: start
@@ -760,178 +817,184 @@ fn polish_from(
     };
     // The grid solution sits at a level ≤ 1 at its samples, but a band's humps between samples
     // may exceed 1: measure nearness from min(top, 1).
-    for c in &candidates {
+    for c in candidates {
         if c.grid_ratio >= top.min(1.0) - ACTIVE_BAND && freedom(norm, &active) > 0 {
             active.points.push(*c);
         }
     }
+    active
+}
 
-    let mut dropped_from: Option<Vec<PointSpec>> = None;
-    let mut drops = 0;
-    for _ in 0..MAX_ACTIVE_SET_ROUNDS {
-        // (More equations than unknowns is allowed: degenerate but consistent systems, e.g.
-        // a single-mode ZVD that also cancels a mode at an odd multiple of its frequency, are
-        // solved by Gauss–Newton in the least-squares sense; inconsistent ones fail there.)
-        if active.impulses.len() < 2 {
-            return None;
-        }
-        let (setup, y0) = build(norm, &active);
-        let solved = sqp(&setup, y0);
-        let Some(solved) = solved else {
-            // No exact solution with this structure: if there is room for another constraint,
-            // activate the next candidate (by V/Vtol on the grid solution) and try again.
-            let next = candidates
-                .iter()
-                .find(|c| c.grid_ratio >= 0.5 * top && !active.points.contains(c));
-            match next {
-                Some(c) if freedom(norm, &active) > 0 => {
-                    active.points.push(*c);
-                    continue;
-                }
-                _ => {}
-            }
-            // Too many (inconsistent) constraints: leave one of them out, in turn, starting
-            // from the one the grid solution held furthest below Vtol.
-            let base = dropped_from.get_or_insert_with(|| active.points.clone());
-            let mut order: Vec<usize> = (0..base.len()).collect();
-            crate::sort::sort_indices(&mut order, &|a, b| {
-                base[a].grid_ratio.total_cmp(&base[b].grid_ratio)
-            });
-            match order.get(drops) {
-                Some(&k) if drops < MAX_DROPS => {
-                    let mut points = base.clone();
-                    points.remove(k);
-                    active.points = points;
-                    drops += 1;
-                    continue;
-                }
-                _ => return None,
-            }
-        };
-        let imps = setup.impulses(&solved.y);
+/// What the loop tries when a structure has no exact solution: the active points before the
+/// first drop, and how many drops were tried.
+struct Retry {
+    dropped_from: Option<Vec<PointSpec>>,
+    drops: usize,
+}
 
-        // Two impulses that converged onto one time are one impulse: merge and solve again.
-        let t_n = imps.last().map_or(0.0, |i| i.time);
-        if let Some(k) = (1..imps.len()).find(|&k| imps[k].time - imps[k - 1].time < 1e-7 * t_n) {
-            let mut merged = imps.clone();
-            let (a, b) = (merged[k - 1], merged[k]);
-            let sum = a.amplitude + b.amplitude;
-            merged[k - 1] = Impulse {
-                time: if sum != 0.0 {
-                    (a.time * a.amplitude + b.time * b.amplitude) / sum
-                } else {
-                    a.time
-                },
-                amplitude: sum,
-            };
-            merged.remove(k);
-            active.impulses = merged;
-            active.bounds = shift_bounds(&active.bounds, k);
-            update_points(&mut active, &setup, &solved.y);
-            continue;
-        }
-
-        // Amplitudes out of bounds: drop an impulse that wants to vanish (lower bound 0),
-        // otherwise pin it to the bound.
-        let tol = 1e-12;
-        if let Some((i, imp)) = imps
+impl Retry {
+    /// No exact solution with this structure: if there is room for another constraint,
+    /// activates the next candidate (by V/Vtol on the grid solution); otherwise (too many,
+    /// inconsistent constraints) leaves one of them out, in turn, starting from the one the
+    /// grid solution held furthest below Vtol. False when nothing is left to try.
+    fn restructure(
+        &mut self,
+        norm: &NormalizedProblem,
+        active: &mut Active,
+        candidates: &[PointSpec],
+        top: f64,
+    ) -> bool {
+        let next = candidates
             .iter()
-            .enumerate()
-            .filter(|(_, imp)| {
-                imp.amplitude < norm.amplitude_min - tol || imp.amplitude > norm.amplitude_max + tol
-            })
-            .max_by(|a, b| {
-                let ex = |x: &Impulse| {
-                    (norm.amplitude_min - x.amplitude).max(x.amplitude - norm.amplitude_max)
-                };
-                ex(a.1).total_cmp(&ex(b.1))
-            })
-        {
-            let upper = imp.amplitude > norm.amplitude_max;
-            active.impulses = imps.clone();
-            if !upper && norm.amplitude_min == 0.0 {
-                active.impulses.remove(i);
-                active.bounds = shift_bounds(&active.bounds, i);
-                if i == 0 {
-                    let t0 = active.impulses.first().map_or(0.0, |x| x.time);
-                    for x in &mut active.impulses {
-                        x.time -= t0;
-                    }
-                }
-            } else {
-                active.bounds.push((i, upper));
-            }
-            update_points(&mut active, &setup, &solved.y);
-            continue;
-        }
-
-        // Multipliers of the inequalities: with L = t_n − λ·c, an inequality c ≤ 0 needs λ ≤ 0
-        // (V/Vtol − 1 ≤ 0; A − A_max ≤ 0) and c = A − A_min ≥ 0 needs λ ≥ 0.
-        let lmax = solved.lambda.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
-        let mut worst: Option<(usize, f64)> = None;
-        for (k, con) in setup.cons.iter().enumerate() {
-            let wrong = match con {
-                Con::Limit(_) | Con::Bound { upper: true, .. } => solved.lambda[k],
-                Con::Bound { upper: false, .. } => -solved.lambda[k],
-                _ => continue,
-            };
-            if wrong > 1e-7 * lmax.max(1e-12) && worst.is_none_or(|(_, w)| wrong > w) {
-                worst = Some((k, wrong));
+            .find(|c| c.grid_ratio >= 0.5 * top && !active.points.contains(c));
+        if let Some(c) = next {
+            if freedom(norm, active) > 0 {
+                active.points.push(*c);
+                return true;
             }
         }
-        if let Some((k, _)) = worst {
-            active.impulses = imps;
-            update_points(&mut active, &setup, &solved.y);
-            match setup.cons[k] {
-                Con::Limit(p) => {
-                    active.points.remove(p);
-                }
-                Con::Bound { index, upper, .. } => {
-                    active.bounds.retain(|&b| b != (index, upper));
-                }
-                _ => {}
+        let base = self
+            .dropped_from
+            .get_or_insert_with(|| active.points.clone());
+        let mut order: Vec<usize> = (0..base.len()).collect();
+        crate::sort::sort_indices(&mut order, &|a, b| {
+            base[a].grid_ratio.total_cmp(&base[b].grid_ratio)
+        });
+        match order.get(self.drops) {
+            Some(&k) if self.drops < MAX_DROPS => {
+                let mut points = base.clone();
+                points.remove(k);
+                active.points = points;
+                self.drops += 1;
+                true
             }
-            continue;
+            _ => false,
         }
-
-        // Constraints the result violates: add the worst one.
-        let mut worst_violation: Option<(PointSpec, f64)> = None;
-        for l in &norm.limits {
-            let r = ratio(&imps, l.omega, l.zeta, l.vtol);
-            if r > 1.0 + CHECK_TOLERANCE * 0.1 && worst_violation.is_none_or(|(_, w)| r > w) {
-                worst_violation = Some((
-                    PointSpec {
-                        omega: l.omega,
-                        zeta: l.zeta,
-                        omega_free: false,
-                        zeta_free: false,
-                        vtol: Vtol::Constant(l.vtol),
-                        bounds: (l.omega, l.omega, l.zeta, l.zeta),
-                        grid_ratio: r,
-                    },
-                    r,
-                ));
-            }
-        }
-        for (b, band) in norm.bands.iter().enumerate() {
-            for p in band_peaks(&imps, band, b, None) {
-                if p.ratio > 1.0 + CHECK_TOLERANCE * 0.1
-                    && worst_violation.is_none_or(|(_, w)| p.ratio > w)
-                {
-                    worst_violation = Some((PointSpec::from_peak(norm, &p), p.ratio));
-                }
-            }
-        }
-        if let Some((spec, _)) = worst_violation {
-            active.impulses = imps;
-            update_points(&mut active, &setup, &solved.y);
-            // Free coordinates of an existing point may have slid onto the new one's place.
-            active.points.push(spec);
-            continue;
-        }
-        return Some(imps);
     }
-    None
+}
+
+/// Two impulses that converged onto one time are one impulse: merges them (true: solve again).
+fn merge_coincident(active: &mut Active, imps: &[Impulse], setup: &Setup, y: &[f64]) -> bool {
+    let t_n = imps.last().map_or(0.0, |i| i.time);
+    let Some(k) = (1..imps.len()).find(|&k| imps[k].time - imps[k - 1].time < 1e-7 * t_n) else {
+        return false;
+    };
+    let mut merged = imps.to_vec();
+    let (a, b) = (merged[k - 1], merged[k]);
+    let sum = a.amplitude + b.amplitude;
+    merged[k - 1] = Impulse {
+        time: if sum != 0.0 {
+            (a.time * a.amplitude + b.time * b.amplitude) / sum
+        } else {
+            a.time
+        },
+        amplitude: sum,
+    };
+    merged.remove(k);
+    active.impulses = merged;
+    active.bounds = shift_bounds(&active.bounds, k);
+    update_points(active, setup, y);
+    true
+}
+
+/// Amplitudes out of bounds: drops the impulse furthest out if it wants to vanish (lower bound
+/// 0), otherwise pins it to the bound (true: solve again).
+fn fix_amplitude(
+    norm: &NormalizedProblem,
+    active: &mut Active,
+    imps: &[Impulse],
+    setup: &Setup,
+    y: &[f64],
+) -> bool {
+    let tol = 1e-12;
+    let Some((i, imp)) = imps
+        .iter()
+        .enumerate()
+        .filter(|(_, imp)| {
+            imp.amplitude < norm.amplitude_min - tol || imp.amplitude > norm.amplitude_max + tol
+        })
+        .max_by(|a, b| {
+            let ex = |x: &Impulse| {
+                (norm.amplitude_min - x.amplitude).max(x.amplitude - norm.amplitude_max)
+            };
+            ex(a.1).total_cmp(&ex(b.1))
+        })
+    else {
+        return false;
+    };
+    let upper = imp.amplitude > norm.amplitude_max;
+    active.impulses = imps.to_vec();
+    if !upper && norm.amplitude_min == 0.0 {
+        active.impulses.remove(i);
+        active.bounds = shift_bounds(&active.bounds, i);
+        if i == 0 {
+            let t0 = active.impulses.first().map_or(0.0, |x| x.time);
+            for x in &mut active.impulses {
+                x.time -= t0;
+            }
+        }
+    } else {
+        active.bounds.push((i, upper));
+    }
+    update_points(active, setup, y);
+    true
+}
+
+/// Multipliers of the inequalities: with L = t_n − λ·c, an inequality c ≤ 0 needs λ ≤ 0
+/// (V/Vtol − 1 ≤ 0; A − A_max ≤ 0) and c = A − A_min ≥ 0 needs λ ≥ 0. Releases the constraint
+/// whose multiplier is most wrong (true: solve again).
+fn release_wrong_sign(
+    active: &mut Active,
+    imps: &[Impulse],
+    setup: &Setup,
+    solved: &Solved,
+) -> bool {
+    let lmax = solved.lambda.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+    let mut worst: Option<(usize, f64)> = None;
+    for (k, con) in setup.cons.iter().enumerate() {
+        let wrong = match con {
+            Con::Limit(_) | Con::Bound { upper: true, .. } => solved.lambda[k],
+            Con::Bound { upper: false, .. } => -solved.lambda[k],
+            _ => continue,
+        };
+        if wrong > 1e-7 * lmax.max(1e-12) && worst.is_none_or(|(_, w)| wrong > w) {
+            worst = Some((k, wrong));
+        }
+    }
+    let Some((k, _)) = worst else {
+        return false;
+    };
+    active.impulses = imps.to_vec();
+    update_points(active, setup, &solved.y);
+    match setup.cons[k] {
+        Con::Limit(p) => {
+            active.points.remove(p);
+        }
+        Con::Bound { index, upper, .. } => {
+            active.bounds.retain(|&b| b != (index, upper));
+        }
+        _ => {}
+    }
+    true
+}
+
+/// The constraint `imps` violates most (a sampled limit or a band's peak), if any.
+fn worst_violation(norm: &NormalizedProblem, imps: &[Impulse]) -> Option<PointSpec> {
+    let mut worst: Option<(PointSpec, f64)> = None;
+    for l in &norm.limits {
+        let r = ratio(imps, l.omega, l.zeta, l.vtol);
+        if r > 1.0 + CHECK_TOLERANCE * 0.1 && worst.is_none_or(|(_, w)| r > w) {
+            worst = Some((limit_point(l, r), r));
+        }
+    }
+    for (b, band) in norm.bands.iter().enumerate() {
+        for p in band_peaks(imps, band, b, None) {
+            if p.ratio > 1.0 + CHECK_TOLERANCE * 0.1 && worst.is_none_or(|(_, w)| p.ratio > w) {
+                worst = Some((PointSpec::from_peak(norm, &p), p.ratio));
+            }
+        }
+    }
+    worst.map(|(spec, _)| spec)
 }
 
 fn shift_bounds(bounds: &[(usize, bool)], removed: usize) -> Vec<(usize, bool)> {
