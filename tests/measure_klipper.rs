@@ -223,10 +223,12 @@ fn figures_of_a_shaper_are_klippers_definitions() {
                 / all
         })
         .fold(0.0, f64::max);
-    assert!((fig.vibrations - r).abs() <= 1e-14 * r.max(1e-3));
+    // (The fit evaluates V by a chain over the bins: equal to 10⁻¹² of R.)
+    assert!((fig.vibrations - r).abs() <= 1e-12 * r.max(1e-3));
     let sm = smoothing::smoothing(&s, 5000.0, 5.0).unwrap();
     assert_eq!(fig.smoothing, sm);
-    assert_eq!(fig.score, sm * (r.powf(1.5) + 0.2 * r + 0.01));
+    let score = sm * (r.powf(1.5) + 0.2 * r + 0.01);
+    assert!((fig.score - score).abs() <= 1e-12 * score);
     assert_eq!(fig.max_accel, smoothing::max_accel(&s, 5.0).unwrap());
     // The curve: 0.2 Hz grid from 0 below 200 Hz, V maximised over the test dampings.
     assert_eq!(fig.freq_bins.len(), 1000);
@@ -550,5 +552,25 @@ mod via_recommend {
         });
         let r = recommend(&a, &[], &opts).unwrap();
         assert_eq!(r.skipped.len(), 1);
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_fits_kernel_is_vibration_rad_to_the_bit() {
+    use input_shaping::measure::klipper::fit::vibration_at;
+    for name in ["zv", "mzv", "zvd", "ei", "2hump_ei", "3hump_ei"] {
+        let s = klipper_shaper(name, 47.3, 0.1).unwrap();
+        for &z in &[0.0, 0.075, 0.1, 0.15] {
+            let damped = (1.0_f64 - z * z).sqrt();
+            for k in 0..200 {
+                let w = 2.0 * PI * (k as f64 * 1.5625);
+                let want = vibration_rad(s.impulses(), w, z);
+                assert_eq!(
+                    vibration_at(s.impulses(), z * w, w * damped),
+                    want,
+                    "{name} {z} {k}"
+                );
+            }
+        }
     }
 }
