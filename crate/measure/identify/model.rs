@@ -185,7 +185,7 @@ impl Problem<'_> {
                 .filter_map(|i| {
                     let fi = x[3 * i].exp();
                     let width = 2.0 * x[3 * i + 1].exp() * fi;
-                    (width < 12.0 * df).then(|| (fi, 5.0 * width + (SPAN_BINS + 1) as f64 * df))
+                    (width < 12.0 * df).then_some((fi, 5.0 * width + (SPAN_BINS + 1) as f64 * df))
                 })
                 .collect();
             for &k in &self.bins {
