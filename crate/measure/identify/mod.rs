@@ -371,7 +371,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         return Ok(result);
     }
     // Segments from the record and the peaks: the narrowest half-power width should span 4 to
-    // 8 bins (the fit models the window's smearing, so a few bins suffice, and shorter
+    // 12 bins (the fit models the window's smearing, so a few bins suffice, and shorter
     // segments average more of them: a sweep's PSD is then steadier). Longer while it spans
     // fewer (up to n/4), or once shorter when it spans more (down to 64 samples).
     let n_max = pow2_floor(n / 4).max(n0).min(1 << 20);
@@ -418,9 +418,9 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         if !narrowest.is_finite() {
             break;
         }
-        if narrowest > 8.0 && !shrunk && seg > 64 {
+        if narrowest > 12.0 && !shrunk && seg > 64 {
             shrunk = true;
-            let factor = pow2_floor((narrowest / 4.0).floor() as usize).max(1);
+            let factor = pow2_floor((narrowest / 6.0).floor() as usize).max(1);
             seg = (seg / factor).max(64);
         } else if narrowest < 4.0 && !shrunk && seg < n_max {
             let factor = (8.0 / narrowest).ceil() as usize;

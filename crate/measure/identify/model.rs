@@ -174,27 +174,35 @@ impl Problem<'_> {
                 );
             }
         } else {
+            // The kernel where a mode is within reach of it (5 half-power widths and the
+            // kernel's own ±5 bins); elsewhere the model is smooth on the scale of a bin and
+            // its value at the bin stands for the convolution.
             let df = inp.resolution_hz;
             let j_max = SPAN_BINS * q;
-            let (k0, k1) = (self.bins[0], self.bins[self.bins.len() - 1]);
             let f0 = inp.frequency_hz[0];
-            let grid0 = (k0 * q) as f64 - j_max as f64;
-            let count = (k1 - k0) * q + 2 * j_max + 1;
-            let fine: Vec<f64> = (0..count)
-                .map(|t| {
-                    let f = f0 + (grid0 + t as f64) * df / q as f64;
-                    response(x, m, self.power, self.f_ref, self.edges, f)
+            // (Only modes narrower than 12 bins: a wider one is smooth on the kernel's scale.)
+            let reach: Vec<(f64, f64)> = (0..m)
+                .filter_map(|i| {
+                    let fi = x[3 * i].exp();
+                    let width = 2.0 * x[3 * i + 1].exp() * fi;
+                    (width < 12.0 * df).then_some((fi, 5.0 * width + (SPAN_BINS + 1) as f64 * df))
                 })
                 .collect();
             for &k in &self.bins {
-                let start = (k - k0) * q;
-                let conv: f64 = kern
-                    .iter()
-                    .zip(&fine[start..start + kern.len()])
-                    .map(|(a, b)| a * b)
-                    .sum();
                 let f = f0 + k as f64 * df;
-                out.push(self.norm(f) * (conv + floor));
+                let near = reach.iter().any(|&(fi, r)| (f - fi).abs() <= r);
+                let value = if near {
+                    kern.iter()
+                        .enumerate()
+                        .map(|(jj, c)| {
+                            let nu = f + (jj as f64 - j_max as f64) * df / q as f64;
+                            c * response(x, m, self.power, self.f_ref, self.edges, nu)
+                        })
+                        .sum()
+                } else {
+                    response(x, m, self.power, self.f_ref, self.edges, f)
+                };
+                out.push(self.norm(f) * (value + floor));
             }
         }
         out.iter().all(|v| v.is_finite() && *v > 0.0)
@@ -252,7 +260,7 @@ impl Problem<'_> {
                     }
                 })
                 .collect();
-            let fit = levenberg_marquardt(residual, &start, &steps, 100)?;
+            let fit = levenberg_marquardt(residual, &start, &steps, 60)?;
             let q_new = self.q_for(&fit.x, m);
             let done = q_new <= q;
             start = fit.x.clone();
@@ -271,7 +279,7 @@ impl Problem<'_> {
         let narrowest = (0..m)
             .map(|i| 2.0 * x[3 * i + 1].exp() * x[3 * i].exp())
             .fold(f64::INFINITY, f64::min);
-        ((6.0 * df / narrowest).ceil() as usize).clamp(4, 64)
+        ((6.0 * df / narrowest).ceil() as usize).clamp(4, 32)
     }
 }
 
@@ -374,6 +382,27 @@ pub(crate) fn fit_modes(
             break;
         }
     }
+    // Every bin within 3 half-power widths (at most 30 bins) and 6 bins of a seed; the others
+    // thinned to about 1500.
+    let near_seed = |k: usize| {
+        seeds.iter().any(|s| {
+            (f[k] - s.frequency_hz).abs()
+                <= (6.0 * s.damping * s.frequency_hz).min(30.0 * df) + 6.0 * df
+        })
+    };
+    let far = bins.iter().filter(|&&k| !near_seed(k)).count();
+    let stride = far.div_ceil(1500).max(1);
+    let mut far_seen = 0;
+    let bins: Vec<usize> = bins
+        .into_iter()
+        .filter(|&k| {
+            if near_seed(k) {
+                return true;
+            }
+            far_seen += 1;
+            (far_seen - 1) % stride == 0
+        })
+        .collect();
     // Inside a swept band's edges the excitation is smooth; at them it is not (and the
     // window smears them over ±2 bins): the fit keeps to the bins 2.5 bins inside.
     let bins: Vec<usize> = bins
@@ -423,10 +452,10 @@ pub(crate) fn fit_modes(
         let m = seeds.len();
         let patterns = if m <= 4 { 1usize << (m - 1) } else { 1 };
         let mut best: Option<(FitResult, usize)> = None;
+        // Starts: white (a = 0) or swept (a = 2: Klipper's acceleration ∝ f at constant Hz/s)
+        // excitation; the direct term of either sign (its level from the low end of the range
+        // under that excitation) or none; every sign pattern of the gains (up to 4 modes).
         for signs in 0..patterns {
-            // Starts: white (a = 0) or swept (a = 2: Klipper's acceleration ∝ f at constant
-            // Hz/s) excitation; the direct term of either sign (its level from the low end of
-            // the range under that excitation) or none.
             for a in [0.0, 2.0] {
                 let c0 = direct / (f[problem.bins[0]] / problem.f_ref).powf(0.5 * a);
                 for c in [c0, -c0, 0.0] {
