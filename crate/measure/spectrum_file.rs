@@ -28,36 +28,14 @@
 use super::psd::{welch, WelchOptions};
 use super::recording::{Channel, Recording, RecordingFormat};
 use crate::error::{Error, Result};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
-/// Klipper's `MIN_FREQ`: normalised PSDs are zero below it, Hz.
-pub const KLIPPER_MIN_FREQ_HZ: f64 = 5.0;
-
-/// Which PSD column is the spectrum's `psd`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum SpectrumChannel {
-    /// `psd_x`.
-    X,
-    /// `psd_y`.
-    Y,
-    /// `psd_z`.
-    Z,
-    /// `psd_xyz` = x + y + z, the one `calibrate_shaper` fits shapers to (default).
-    #[default]
-    Sum,
-}
-
-/// Whether Klipper's `normalize_to_frequencies` was applied to the PSDs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum Normalization {
-    /// The PSD as Welch computed it.
-    #[default]
-    None,
-    /// Divided by f + 0.1 and tapered below 10 Hz (see [`klipper_normalize`]).
-    Klipper,
-}
+// Klipper's channel, normalisation flag, normalisation and MIN_FREQ: one definition each, in
+// `klipper::data` (Klipper's `CalibrationData`), named here as the file reader has used them.
+pub use super::klipper::data::{
+    normalize as klipper_normalize, Channel as SpectrumChannel, Normalization,
+    MIN_FREQ as KLIPPER_MIN_FREQ_HZ,
+};
 
 /// A shaper Klipper fitted, as written in a calibration-data file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -163,21 +141,6 @@ impl SpectrumFile {
         }
         self.normalization = Normalization::Klipper;
         self
-    }
-}
-
-/// Klipper's `normalize_to_frequencies` as the current source has it
-/// (`klippy/extras/shaper_calibrate.py`, `CalibrationData.normalize_to_frequencies`):
-/// psd /= f + 0.1, and below 2·[`KLIPPER_MIN_FREQ_HZ`] = 10 Hz also psd ·= e^{1 − (10/(f + 0.1))²}.
-/// (Klipper's releases before 2024 set the PSD to 0 below 5 Hz instead; the two agree above
-/// 10 Hz, the only part [`crate::measure::identify::identify_spectrum`] fits.)
-pub fn klipper_normalize(frequency_hz: &[f64], psd: &mut [f64]) {
-    let low = 2.0 * KLIPPER_MIN_FREQ_HZ;
-    for (p, &f) in psd.iter_mut().zip(frequency_hz) {
-        *p /= f + 0.1;
-        if f < low {
-            *p *= (1.0 - (low / (f + 0.1)).powi(2)).exp();
-        }
     }
 }
 
