@@ -12,6 +12,7 @@
 pub mod fft;
 mod fit;
 pub mod identify;
+pub mod optimal;
 pub mod psd;
 pub mod recommend;
 pub mod recording;
