@@ -381,11 +381,16 @@ pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, J
 /// `recommendShaper(spectrum, modes, options?)`: `spectrum = { frequencyHz, psd }` (arrays or
 /// `Float64Array`s, e.g. `identifyModes(…).spectrum`), `modes = [{ frequencyHz, damping,
 /// frequencyUncertaintyHz?, dampingUncertainty? }]` (e.g. `identifyModes(…).modes`), options
-/// `{ families?: [{ family, … }], criterion?: 'duration' | 'klipper', maxRemainingVibration?,
-/// scv?, uncertaintySigmas?, minFrequencyHz?, maxFrequencyHz? }` → `{ criterion, recommended,
+/// `{ families?: [{ family, … }], criterion?: 'duration' | 'klipper' | 'optimal',
+/// firmware?: 'klipper' | 'kalico' | 'reprapfirmware', maxRemainingVibration?, scv?,
+/// uncertaintySigmas?, minFrequencyHz?, maxFrequencyHz? }` → `{ criterion, recommended,
 /// ranked: [{ label, family, spec, modes, shaper, durationS, remainingVibration,
 /// nominalRemainingVibration, smoothing, maxAccel, klipperScore, acceptable }], dampingTested,
-/// frequencyFactors, bandHz }`.
+/// frequencyFactors, bandHz, note? }`. `criterion: 'optimal'`: the shaper optimised for the
+/// spectrum by Klipper's own score (crate::measure::optimal) — for `firmware: 'klipper'` the
+/// best mainline family × frequency × damping ratio, else a custom impulse sequence within the
+/// firmware's limits — ranked first, then the other rows of its table (Klipper's own pick
+/// among them), with `note` saying what it bought.
 #[cfg(feature = "js-playground")]
 #[wasm_bindgen(js_name = recommendShaper)]
 pub fn recommend_shaper(

@@ -45,6 +45,10 @@ use crate::shaper::{Impulse, Shaper, ShaperData};
 use crate::smoothing;
 use serde::{Deserialize, Serialize};
 
+use super::klipper::{
+    find_best_shaper, klipper_figures_on, klipper_shaper, CalibrationData, Channel, FitOptions,
+    KLIPPER_SHAPERS,
+};
 use super::recommend::{remaining_vibration, MeasuredMode, MeasuredSpectrum};
 
 #[cfg(feature = "solver")]
@@ -57,7 +61,7 @@ pub const KLIPPER_TEST_DAMPING: [f64; 3] = [0.075, 0.1, 0.15];
 /// Klipper's pick's and 5 %).
 pub const VIBRATION_ALLOWANCE: f64 = 0.05;
 /// Relative frequency band always scored for the custom shaper (± this fraction).
-pub const DEFAULT_FREQUENCY_BAND: f64 = 0.02;
+pub const DEFAULT_FREQUENCY_BAND: f64 = 0.0;
 /// Damping ratios of the mainline scan (each family up to its `max_damping_ratio`).
 const DAMPING_GRID: [f64; 4] = [0.05, 0.1, 0.15, 0.25];
 /// Relative step of the mainline frequency scan (refined afterwards by a pattern search).
@@ -251,19 +255,23 @@ pub struct OptimalReport {
     pub evaluations: usize,
 }
 
-/// The spectrum as Klipper scores it, with the evaluation sets.
+/// The runs as Klipper scores them, with the evaluation sets.
 struct Scorer {
-    /// Bins with PSD above Klipper's threshold (the others add nothing for a shaper with
-    /// positive amplitudes, whose V ≤ 1).
-    freq: Vec<f64>,
-    psd: Vec<f64>,
-    /// Every bin (for shapers with negative amplitudes).
-    all_freq: Vec<f64>,
-    all_psd: Vec<f64>,
+    /// Per run: the bins with PSD above Klipper's threshold (the others add nothing for a
+    /// shaper with positive amplitudes, whose V ≤ 1), and every bin ≤ 200 Hz.
+    runs: Vec<Run>,
     /// (ζ, factor, part of Klipper's own set)
     cases: Vec<(f64, f64, bool)>,
     scv: f64,
     evaluations: std::cell::Cell<usize>,
+}
+
+/// One run's bins.
+struct Run {
+    freq: Vec<f64>,
+    psd: Vec<f64>,
+    all_freq: Vec<f64>,
+    all_psd: Vec<f64>,
 }
 
 /// Klipper's score from smoothing and R (shaper_calibrate.py `fit_shaper`).
@@ -290,20 +298,30 @@ impl Eval {
 
 impl Scorer {
     fn new(
-        freq: Vec<f64>,
-        psd: Vec<f64>,
+        runs: &[(Vec<f64>, Vec<f64>)],
         robust_damping: &[f64],
         factors: &[f64],
         scv: f64,
     ) -> Self {
-        let p_max = psd.iter().copied().fold(0.0, f64::max);
-        let threshold = p_max / super::recommend::SHAPER_VIBRATION_REDUCTION;
-        let (f_red, p_red): (Vec<f64>, Vec<f64>) = freq
+        let runs = runs
             .iter()
-            .zip(&psd)
-            .filter(|(_, &p)| p > threshold)
-            .map(|(&f, &p)| (f, p))
-            .unzip();
+            .map(|(freq, psd)| {
+                let p_max = psd.iter().copied().fold(0.0, f64::max);
+                let threshold = p_max / super::recommend::SHAPER_VIBRATION_REDUCTION;
+                let (f_red, p_red): (Vec<f64>, Vec<f64>) = freq
+                    .iter()
+                    .zip(psd)
+                    .filter(|(_, &p)| p > threshold)
+                    .map(|(&f, &p)| (f, p))
+                    .unzip();
+                Run {
+                    freq: f_red,
+                    psd: p_red,
+                    all_freq: freq.clone(),
+                    all_psd: psd.clone(),
+                }
+            })
+            .collect();
         let mut cases: Vec<(f64, f64, bool)> = KLIPPER_TEST_DAMPING
             .iter()
             .map(|&z| (z, 1.0, true))
@@ -319,10 +337,7 @@ impl Scorer {
             }
         }
         Scorer {
-            freq: f_red,
-            psd: p_red,
-            all_freq: freq,
-            all_psd: psd,
+            runs,
             cases,
             scv,
             evaluations: std::cell::Cell::new(0),
@@ -333,21 +348,23 @@ impl Scorer {
     fn eval(&self, shaper: &Shaper, robust: bool) -> Result<Eval> {
         self.evaluations.set(self.evaluations.get() + 1);
         let positive = shaper.impulses().iter().all(|i| i.amplitude >= 0.0);
-        let (f, p) = if positive {
-            (&self.freq, &self.psd)
-        } else {
-            (&self.all_freq, &self.all_psd)
-        };
         let (mut own_r, mut robust_r) = (0.0_f64, 0.0_f64);
-        for &(z, s, own) in &self.cases {
-            if !own && !robust {
-                continue;
+        for run in &self.runs {
+            let (f, p) = if positive {
+                (&run.freq, &run.psd)
+            } else {
+                (&run.all_freq, &run.all_psd)
+            };
+            for &(z, s, own) in &self.cases {
+                if !own && !robust {
+                    continue;
+                }
+                let r = remaining_vibration(shaper, f, p, z, s);
+                if own {
+                    own_r = own_r.max(r);
+                }
+                robust_r = robust_r.max(r);
             }
-            let r = remaining_vibration(shaper, f, p, z, s);
-            if own {
-                own_r = own_r.max(r);
-            }
-            robust_r = robust_r.max(r);
         }
         let smoothing = smoothing::smoothing(shaper, smoothing::KLIPPER_ACCEL, self.scv)?;
         Ok(Eval {
@@ -355,20 +372,6 @@ impl Scorer {
             robust_r,
             smoothing,
         })
-    }
-
-    fn figures(&self, shaper: &Shaper) -> Result<(Figures, Eval)> {
-        let e = self.eval(shaper, true)?;
-        let max_accel = smoothing::max_accel(shaper, self.scv)?;
-        Ok((
-            Figures {
-                vibrations: e.own_r,
-                smoothing: e.smoothing,
-                max_accel,
-                score: e.own_score(),
-            },
-            e,
-        ))
     }
 }
 
@@ -397,71 +400,30 @@ impl Bounds {
     }
 }
 
-// ---------------------------------------------------------------------------------------------
-// The family table. TEMPORARY: until the Klipper reproduction lands (crate/measure/klipper),
-// the crate's exact families stand in for Klipper's damped forms.
-// ---------------------------------------------------------------------------------------------
-
-/// The mainline families: (name, max damping ratio), Klipper's shaper_defs.py `INPUT_SHAPERS`.
-const FAMILIES: [(&str, f64); 6] = [
-    ("zv", 0.99),
-    ("mzv", 0.99),
-    ("zvd", 0.99),
-    ("ei", 0.4),
-    ("2hump_ei", 0.3),
-    ("3hump_ei", 0.2),
-];
-
-fn family_shaper(name: &str, freq: f64, damping_ratio: f64) -> Result<Shaper> {
-    if std::env::var("OPT_FAST").is_ok() && name.contains("ei") {
-        return Err(Error::invalid("x", "skip"));
-    }
-    use crate::design::{design_for, ShaperSpec};
-    let vtol = 0.05;
-    let spec = match name {
-        "zv" => ShaperSpec::Zv,
-        "mzv" => ShaperSpec::Mzv,
-        "zvd" => ShaperSpec::Zvd,
-        "ei" => ShaperSpec::Ei { vtol },
-        "2hump_ei" => ShaperSpec::Ei2 { vtol },
-        _ => ShaperSpec::Ei3 { vtol },
-    };
-    design_for(&spec, &[crate::mode::Mode::new(freq, damping_ratio)?])
-}
-
-/// Klipper's pick on the spectrum (TEMPORARY: the least own score over Klipper's scan).
-fn klipper_pick(scorer: &Scorer) -> Result<Mainline> {
-    let mut best: Option<Mainline> = None;
-    for &(name, _) in &FAMILIES {
-        if name == "zvd" {
-            continue;
-        }
-        let mut f = 5.0;
-        while f < 200.0 {
-            if let Ok(shaper) = family_shaper(name, f, 0.1) {
-                let e = scorer.eval(&shaper, false)?;
-                if best
-                    .as_ref()
-                    .is_none_or(|b| e.own_score() < b.eval.own_score())
-                {
-                    best = Some(Mainline {
-                        family: name,
-                        freq: f,
-                        damping_ratio: 0.1,
-                        shaper,
-                        eval: e,
-                    });
-                }
-            }
-            f += 0.2;
-        }
-    }
-    best.ok_or_else(|| Error::Infeasible {
-        reason: "no Klipper shaper could be scored".into(),
+/// Klipper's pick on `data`: `find_best_shaper` of the crate's reproduction, and its shaper.
+fn klipper_pick(scorer: &Scorer, data: &CalibrationData, scv: f64) -> Result<Mainline> {
+    let fit = find_best_shaper(
+        data,
+        &FitOptions {
+            scv,
+            ..FitOptions::default()
+        },
+    )?;
+    let best = fit
+        .families
+        .get(fit.best)
+        .ok_or_else(|| Error::Infeasible {
+            reason: "Klipper's fit returned no family".into(),
+        })?;
+    let shaper = klipper_shaper(best.name, best.pick.freq, fit.damping_ratio)?;
+    Ok(Mainline {
+        family: best.name,
+        freq: best.pick.freq,
+        damping_ratio: fit.damping_ratio,
+        eval: scorer.eval(&shaper, true)?,
+        shaper,
     })
 }
-
-// ---------------------------------------------------------------------------------------------
 
 /// The best mainline shaper by the robust score under `bounds`; `pick` is the fallback.
 fn best_mainline(
@@ -473,13 +435,14 @@ fn best_mainline(
     // Per family: the scan's best points (one per damping ratio, the best few overall), each
     // refined by a pattern search; the best refined one is the family's.
     let mut per_family: Vec<Mainline> = Vec::new();
-    for &(name, max_dr) in &FAMILIES {
+    for def in &KLIPPER_SHAPERS {
+        let (name, max_dr) = (def.name, def.max_damping_ratio);
         let mut seeds: Vec<Mainline> = Vec::new();
         for &dr in DAMPING_GRID.iter().filter(|&&d| d <= max_dr) {
             let mut best: Option<Mainline> = None;
             let mut f = band[0];
             while f <= band[1] {
-                if let Ok(shaper) = family_shaper(name, f, dr) {
+                if let Ok(shaper) = klipper_shaper(name, f, dr) {
                     let e = scorer.eval(&shaper, true)?;
                     if bounds.admits(&e)
                         && best
@@ -537,7 +500,7 @@ fn refine_mainline(
         for (sf, sd) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)] {
             let f = best.freq * (1.0 + sf * df);
             let dr = (best.damping_ratio + sd * dd).clamp(0.0, max_dr);
-            let Ok(shaper) = family_shaper(best.family, f, dr) else {
+            let Ok(shaper) = klipper_shaper(best.family, f, dr) else {
                 continue;
             };
             let e = scorer.eval(&shaper, true)?;
@@ -796,7 +759,10 @@ fn best_custom(
     };
     if method != CustomMethod::Grid {
         for start in starts.iter().take(CONTINUATION_STARTS) {
-            consider(polish_custom(scorer, bounds, limits, &start.shaper)?, &mut best);
+            consider(
+                polish_custom(scorer, bounds, limits, &start.shaper)?,
+                &mut best,
+            );
         }
     }
     if method != CustomMethod::Continuation {
@@ -819,19 +785,27 @@ fn best_custom(
 
 /// Starts from the convex grid program around the best mainline shaper's duration.
 #[cfg(feature = "solver")]
-fn grid_starts(scorer: &Scorer, limits: FirmwareLimits, starts: &[Mainline]) -> Result<Vec<Shaper>> {
+fn grid_starts(
+    scorer: &Scorer,
+    limits: FirmwareLimits,
+    starts: &[Mainline],
+) -> Result<Vec<Shaper>> {
     let Some(first) = starts.first() else {
         return Ok(Vec::new());
     };
-    let p_max = scorer.psd.iter().copied().fold(0.0, f64::max);
-    let threshold = p_max / super::recommend::SHAPER_VIBRATION_REDUCTION;
+    let mut bins = Vec::new();
+    for run in &scorer.runs {
+        let p_max = run.psd.iter().copied().fold(0.0, f64::max);
+        let threshold = p_max / super::recommend::SHAPER_VIBRATION_REDUCTION;
+        bins.extend(
+            run.freq
+                .iter()
+                .zip(&run.psd)
+                .map(|(&f, &p)| (f, threshold / p)),
+        );
+    }
     let cones = grid::Cones {
-        bins: scorer
-            .freq
-            .iter()
-            .zip(&scorer.psd)
-            .map(|(&f, &p)| (f, threshold / p))
-            .collect(),
+        bins,
         cases: scorer.cases.iter().map(|c| (c.0, c.1)).collect(),
     };
     let max_n = limits.max_impulses.min(MAX_CUSTOM_IMPULSES);
@@ -853,52 +827,31 @@ fn grid_starts(_: &Scorer, _: FirmwareLimits, _: &[Mainline]) -> Result<Vec<Shap
     })
 }
 
-/// The spectrum checked and cut to Klipper's band (TEMPORARY: to 200 Hz as given).
-fn prepared(spectrum: &MeasuredSpectrum) -> Result<(Vec<f64>, Vec<f64>)> {
-    count(
-        "spectrum.psd",
-        spectrum.psd.len(),
-        2,
-        super::recommend::MAX_BINS,
-    )?;
-    if spectrum.frequency_hz.len() != spectrum.psd.len() {
-        return Err(Error::invalid(
-            "spectrum.frequencyHz",
-            format!(
-                "has {} values but psd has {}",
-                spectrum.frequency_hz.len(),
-                spectrum.psd.len()
-            ),
-        ));
-    }
-    for (i, (&f, &p)) in spectrum.frequency_hz.iter().zip(&spectrum.psd).enumerate() {
-        if !(f.is_finite() && f >= 0.0) {
+/// Each run's bins up to Klipper's 200 Hz on the summed PSD (Klipper's `fit_shaper` input),
+/// checked: every run must have a non-zero PSD there.
+fn prepared(data: &CalibrationData) -> Result<Vec<(Vec<f64>, Vec<f64>)>> {
+    let mut out = Vec::new();
+    for run in data.datasets() {
+        let psd = run.psd(Channel::Sum).unwrap_or(&[]);
+        let n = run
+            .freq_bins
+            .partition_point(|&f| f <= super::klipper::fit::MAX_FREQ);
+        let (f, p) = (
+            run.freq_bins[..n].to_vec(),
+            psd[..n.min(psd.len())].to_vec(),
+        );
+        if p.iter().all(|&x| x == 0.0) {
             return Err(Error::invalid(
-                format!("spectrum.frequencyHz[{i}]"),
-                format!("must be a finite frequency ≥ 0, got {f}"),
+                "spectrum.psd",
+                format!(
+                    "run '{}' is zero everywhere up to 200 Hz: nothing to shape",
+                    run.name
+                ),
             ));
         }
-        if !(p.is_finite() && p >= 0.0) {
-            return Err(Error::invalid(
-                format!("spectrum.psd[{i}]"),
-                format!("must be a finite value ≥ 0, got {p}"),
-            ));
-        }
+        out.push((f, p));
     }
-    let (f, p): (Vec<f64>, Vec<f64>) = spectrum
-        .frequency_hz
-        .iter()
-        .zip(&spectrum.psd)
-        .filter(|(&f, _)| f <= 200.0)
-        .map(|(&f, &p)| (f, p))
-        .unzip();
-    if p.iter().all(|&x| x == 0.0) {
-        return Err(Error::invalid(
-            "spectrum.psd",
-            "is zero everywhere up to 200 Hz: nothing to shape",
-        ));
-    }
-    Ok((f, p))
+    Ok(out)
 }
 
 fn family_config(family: &str, freq: f64, dr: f64) -> String {
@@ -923,28 +876,32 @@ fn custom_config(firmware: Firmware, shaper: &Shaper) -> String {
     }
 }
 
-/// Klipper's own figures of any `shaper` on `spectrum` (cut to 200 Hz; R over 0.075 / 0.1 /
-/// 0.15), e.g. to score a shaper designed on one recording on another recording of the same
-/// axis.
-pub fn klipper_figures(spectrum: &MeasuredSpectrum, shaper: &Shaper, scv: f64) -> Result<Figures> {
-    let (freq, psd) = prepared(spectrum)?;
-    finite("scv", scv)?;
-    let scorer = Scorer::new(freq, psd, &[], &[1.0], scv);
-    Ok(scorer.figures(shaper)?.0)
+/// Klipper's own figures of `shaper` on `data`, by the crate's reproduction
+/// ([`klipper_figures_on`]: R over 0.075 / 0.1 / 0.15 and the runs, bins ≤ 200 Hz).
+fn own_figures(shaper: &Shaper, data: &CalibrationData, scv: f64) -> Result<Figures> {
+    let f = klipper_figures_on(shaper, data, None, scv, None, Channel::Sum)?;
+    Ok(Figures {
+        vibrations: f.vibrations,
+        smoothing: f.smoothing,
+        max_accel: f.max_accel,
+        score: f.score,
+    })
 }
 
 /// Klipper's pick, the best mainline-Klipper shaper and (for a custom-shaper firmware) the best
-/// custom shaper for the measured `spectrum`, with the robust score widened by `modes` (may be
-/// empty: Klipper's damping set then). See the module docs.
+/// custom shaper for Klipper's calibration `data` (normalised as Klipper scores it: see
+/// [`CalibrationData::normalize_to_frequencies`]; several runs are pessimised over, as Klipper
+/// does), with the robust score widened by `modes` (may be empty: Klipper's damping set then).
+/// See the module docs.
 ///
-/// Errors: an empty, mismatched or non-finite spectrum, a PSD that is zero up to 200 Hz, a bad
-/// mode (`modes[i]…`), `uncertaintySigmas` outside [0, 10].
+/// Errors: a run whose PSD is zero up to 200 Hz, a bad mode (`modes[i]…`),
+/// `uncertaintySigmas` outside [0, 10], Klipper's fit's errors.
 pub fn optimal(
-    spectrum: &MeasuredSpectrum,
+    data: &CalibrationData,
     modes: &[MeasuredMode],
     options: &OptimalOptions,
 ) -> Result<OptimalReport> {
-    let (freq, psd) = prepared(spectrum)?;
+    let runs = prepared(data)?;
     let k = options.uncertainty_sigmas;
     if !(0.0..=10.0).contains(&k) {
         return Err(Error::invalid(
@@ -978,30 +935,19 @@ pub fn optimal(
     let d = rel_f.clamp(DEFAULT_FREQUENCY_BAND, 0.5);
     let custom_factors = vec![1.0 - d, 1.0, 1.0 + d];
 
-    let scorer = Scorer::new(
-        freq.clone(),
-        psd.clone(),
-        &damping,
-        &mainline_factors,
-        options.scv,
-    );
-    let pick = klipper_pick(&scorer)?;
-    let pick_eval = scorer.eval(&pick.shaper, true)?;
-    let pick = Mainline {
-        eval: pick_eval,
-        ..pick
-    };
+    let scorer = Scorer::new(&runs, &damping, &mainline_factors, options.scv);
+    let pick = klipper_pick(&scorer, data, options.scv)?;
     let bounds = Bounds {
         score: pick.eval.own_score(),
         vibrations: pick.eval.own_r.max(VIBRATION_ALLOWANCE),
     };
-    let lowest = freq.iter().copied().find(|&f| f > 0.0).unwrap_or(1.0);
-    let band = [lowest.max(5.0), 200.0];
+    let band = [5.0, super::klipper::fit::MAX_SHAPER_FREQ];
     let mainlines = best_mainline(&scorer, bounds, &pick, band)?;
     let main = mainlines[0].clone();
 
     let row_of = |kind: &'static str, m: &Mainline| -> Result<OptimalRow> {
-        let (fig, e) = scorer.figures(&m.shaper)?;
+        let e = scorer.eval(&m.shaper, true)?;
+        let fig = own_figures(&m.shaper, data, options.scv)?;
         Ok(OptimalRow {
             kind,
             family: m.family.to_string(),
@@ -1027,7 +973,7 @@ pub fn optimal(
         100.0 * main_gain
     );
     if let Some(limits) = options.firmware.limits() {
-        let custom_scorer = Scorer::new(freq, psd, &damping, &custom_factors, options.scv);
+        let custom_scorer = Scorer::new(&runs, &damping, &custom_factors, options.scv);
         let starts: Vec<Mainline> = mainlines
             .iter()
             .map(|m| -> Result<Mainline> {
@@ -1055,7 +1001,8 @@ pub fn optimal(
             Some(c) => (c.shaper, c.eval),
             None => (main.shaper.clone(), main.eval),
         };
-        let (fig, e) = scorer.figures(&shaper)?;
+        let e = scorer.eval(&shaper, true)?;
+        let fig = own_figures(&shaper, data, options.scv)?;
         let gain_over_main = 1.0 - fig.score / rows[1].klipper.score;
         rows.push(OptimalRow {
             kind: "custom",
@@ -1091,5 +1038,91 @@ pub fn optimal(
         damping_tested: damping,
         frequency_factors: custom_factors,
         evaluations: scorer.evaluations.get(),
+    })
+}
+
+/// `criterion: "optimal"` of [`super::recommend::recommend`]: the measured `spectrum` read as
+/// Klipper reads a PSD it computed or a `resonances_*.csv` (normalised with
+/// [`CalibrationData::normalize_to_frequencies`]), [`optimal`] run for `options.firmware`, and
+/// its table as the ranked candidates: the recommended one (custom for a custom-shaper
+/// firmware, else the best mainline one) first, then the others by Klipper's score. Each
+/// candidate's `spec` is its impulse sequence (`custom`), `remainingVibration` and
+/// `klipperScore` Klipper's own, `nominalRemainingVibration` the robust R.
+pub fn recommend_optimal(
+    spectrum: &MeasuredSpectrum,
+    modes: &[MeasuredMode],
+    options: &super::recommend::RecommendOptions,
+) -> Result<super::recommend::Recommendation> {
+    use super::recommend::{Candidate, Criterion, Recommendation};
+    let run = super::klipper::Dataset::new(
+        "spectrum",
+        spectrum.frequency_hz.clone(),
+        spectrum.psd.clone(),
+        None,
+        false,
+    )
+    .map_err(|e| e.within("spectrum"))?;
+    let mut data = CalibrationData::new(run);
+    data.normalize_to_frequencies();
+    let report = optimal(
+        &data,
+        modes,
+        &OptimalOptions {
+            firmware: options.firmware,
+            uncertainty_sigmas: options.uncertainty_sigmas,
+            scv: options.scv,
+            custom_method: CustomMethod::Continuation,
+        },
+    )?;
+    let vmax = options.max_remaining_vibration;
+    let mut order: Vec<usize> = (0..report.rows.len()).collect();
+    order.sort_by(|&a, &b| {
+        (b == report.recommended)
+            .cmp(&(a == report.recommended))
+            .then(
+                report.rows[a]
+                    .klipper
+                    .score
+                    .total_cmp(&report.rows[b].klipper.score),
+            )
+    });
+    let ranked = order
+        .iter()
+        .map(|&i| {
+            let row = &report.rows[i];
+            let family = super::klipper::shaper_def(&row.family).map_or("custom", |d| d.name);
+            let label = match (row.kind, row.shaper_freq_hz, row.damping_ratio) {
+                ("klipper", Some(f), _) => format!("{family} {f:.1} Hz (Klipper's pick)"),
+                (_, Some(f), Some(z)) => format!("{family} {f:.2} Hz, damping_ratio {z:.3}"),
+                _ => format!("custom, {} impulses", row.shaper.impulses.len()),
+            };
+            Candidate {
+                label,
+                family,
+                spec: crate::design::ShaperSpec::Custom {
+                    impulses: row.shaper.impulses.clone(),
+                    normalize: false,
+                },
+                modes: Vec::new(),
+                duration_s: row.shaper.duration,
+                shaper: row.shaper.clone(),
+                remaining_vibration: row.klipper.vibrations,
+                nominal_remaining_vibration: row.robust_vibrations,
+                smoothing: Some(row.klipper.smoothing),
+                max_accel: Some(row.klipper.max_accel).filter(|a| a.is_finite()),
+                klipper_score: Some(row.klipper.score),
+                acceptable: row.klipper.vibrations <= vmax,
+            }
+        })
+        .collect();
+    Ok(Recommendation {
+        criterion: Criterion::Optimal,
+        recommended: 0,
+        ranked,
+        skipped: Vec::new(),
+        damping_tested: report.damping_tested,
+        frequency_factors: report.frequency_factors,
+        band_hz: [0.0, super::klipper::fit::MAX_FREQ],
+        note: Some(report.note),
     })
 }

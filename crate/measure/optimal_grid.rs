@@ -34,7 +34,13 @@ pub(super) struct Cones {
 }
 
 /// The least-smoothing amplitudes on the grid with R = 0, or `None` when infeasible.
-fn solve(cones: &Cones, t_end: f64, centroid: f64, scv: f64, last_min: f64) -> Option<Vec<Impulse>> {
+fn solve(
+    cones: &Cones,
+    t_end: f64,
+    centroid: f64,
+    scv: f64,
+    last_min: f64,
+) -> Option<Vec<Impulse>> {
     let n_amp = GRID_INTERVALS + 1;
     let times: Vec<f64> = (0..n_amp)
         .map(|j| t_end * j as f64 / GRID_INTERVALS as f64)

@@ -87,6 +87,10 @@ pub enum Criterion {
     Duration,
     /// Klipper's score and selection rule.
     Klipper,
+    /// The shaper optimised for the spectrum by Klipper's own score, never worse than
+    /// Klipper's pick ([`super::optimal`]); `firmware` says which kind (mainline Klipper's
+    /// family × frequency × damping ratio, or a custom impulse sequence).
+    Optimal,
 }
 
 /// Options of [`recommend`] (JS: `{ families, criterion, maxRemainingVibration, scv,
@@ -108,6 +112,9 @@ pub struct RecommendOptions {
     pub min_frequency_hz: Option<f64>,
     /// Upper end (default 3 × the highest mode's frequency, or the spectrum's last bin), Hz.
     pub max_frequency_hz: Option<f64>,
+    /// With `criterion: "optimal"`: the firmware (`klipper`, `kalico`, `reprapfirmware`;
+    /// default `klipper`).
+    pub firmware: super::optimal::Firmware,
 }
 
 impl Default for RecommendOptions {
@@ -120,6 +127,7 @@ impl Default for RecommendOptions {
             uncertainty_sigmas: 2.0,
             min_frequency_hz: None,
             max_frequency_hz: None,
+            firmware: super::optimal::Firmware::Klipper,
         }
     }
 }
@@ -195,6 +203,9 @@ pub struct Recommendation {
     pub frequency_factors: Vec<f64>,
     /// Band scored, Hz.
     pub band_hz: [f64; 2],
+    /// With `criterion: "optimal"`: what the optimisation bought, in words.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 /// Klipper's remaining vibration R of `shaper` over bins (f, P), V at `zeta` and f·`factor`.
@@ -232,6 +243,9 @@ pub fn recommend(
     modes: &[MeasuredMode],
     options: &RecommendOptions,
 ) -> Result<Recommendation> {
+    if options.criterion == Criterion::Optimal {
+        return super::optimal::recommend_optimal(spectrum, modes, options);
+    }
     count("spectrum.psd", spectrum.psd.len(), 2, MAX_BINS)?;
     if spectrum.frequency_hz.len() != spectrum.psd.len() {
         return Err(Error::invalid(
@@ -456,7 +470,8 @@ pub fn recommend(
             });
             recommended_label = candidates[0].label.clone();
         }
-        Criterion::Klipper => {
+        // (`Optimal` returned at the top; it never reaches here.)
+        Criterion::Klipper | Criterion::Optimal => {
             // find_best_shaper's walk, in the candidates' (families') order.
             let mut best: Option<&Candidate> = None;
             for c in candidates.iter().filter(|c| c.klipper_score.is_some()) {
@@ -499,5 +514,6 @@ pub fn recommend(
         damping_tested,
         frequency_factors,
         band_hz: [f_lo, f_hi],
+        note: None,
     })
 }
