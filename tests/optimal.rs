@@ -246,3 +246,43 @@ fn bad_input_is_refused_with_the_field() {
     let e = optimal(&zero, &[], &OptimalOptions::default()).unwrap_err();
     assert!(e.field().is_some(), "{e:?}");
 }
+
+#[test]
+fn recommend_criterion_optimal_ranks_the_optimised_shaper_first() {
+    use input_shaping::measure::optimal::Firmware;
+    use input_shaping::measure::recommend::{
+        recommend, Criterion, MeasuredSpectrum, RecommendOptions,
+    };
+    // The raw (unnormalised) PSD, as identifyModes' spectrum or a resonances file gives it:
+    // recommend normalises it as Klipper does, so Klipper's pick is the golden one.
+    let text = std::fs::read_to_string(Path::new(DIR).join("resonances_x_z008f47.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let spectrum = MeasuredSpectrum {
+        frequency_hz: rows.iter().map(|r| r[0]).collect(),
+        psd: rows.iter().map(|r| r[4]).collect(),
+    };
+    let options = RecommendOptions {
+        criterion: Criterion::Optimal,
+        firmware: Firmware::Reprapfirmware,
+        ..RecommendOptions::default()
+    };
+    let r = recommend(&spectrum, &[], &options).unwrap();
+    assert_eq!(r.criterion, Criterion::Optimal);
+    assert_eq!(r.recommended, 0);
+    assert_eq!(r.ranked.len(), 3);
+    assert_eq!(r.ranked[0].family, "custom");
+    let pick = r
+        .ranked
+        .iter()
+        .find(|c| c.label.contains("Klipper's pick"))
+        .unwrap();
+    assert_eq!(pick.family, "mzv");
+    assert!(pick.label.starts_with("mzv 47.8 Hz"), "{}", pick.label);
+    let score = |i: usize| r.ranked[i].klipper_score.unwrap();
+    assert!(score(0) <= pick.klipper_score.unwrap());
+    assert!(r.note.as_deref().is_some_and(|n| !n.is_empty()));
+}
