@@ -136,3 +136,53 @@ fn welch_accepts_typed_and_plain_arrays_and_names_bad_fields() {
         Some("sampleRateHz")
     );
 }
+
+/// recommendShaper with criterion 'klipper' (issue 20 item 3): a spectrum object with typed
+/// arrays, no modes, Klipper's table in `klipper`; the normalisation flag read; a bad flag named.
+#[wasm_bindgen_test]
+fn recommend_shaper_klipper_criterion_from_js() {
+    // One mode at 45 Hz, ζ 0.06, on Klipper's bins (3200 Hz, 2048 points), not normalised.
+    let f: Vec<f64> = (0..=1024).map(|k| k as f64 * 3200.0 / 2048.0).collect();
+    let psd: Vec<f64> = f
+        .iter()
+        .map(|&x| {
+            let r = x / 45.0;
+            1e-4 + r.powi(4) / ((1.0 - r * r).powi(2) + (0.12 * r).powi(2))
+        })
+        .collect();
+    let spectrum = js_sys::Object::new();
+    let set = |o: &js_sys::Object, k: &str, v: &JsValue| {
+        Reflect::set(o, &k.into(), v).unwrap();
+    };
+    set(
+        &spectrum,
+        "frequencyHz",
+        &Float64Array::from(f.as_slice()).into(),
+    );
+    set(&spectrum, "psd", &Float64Array::from(psd.as_slice()).into());
+    let options = js(r#"{"criterion":"klipper"}"#);
+    let r = api::recommend_shaper(spectrum.clone().into(), JsValue::UNDEFINED, options.clone())
+        .unwrap();
+    let klipper = get(&r, "klipper");
+    let families: js_sys::Array = get(&klipper, "families").dyn_into().unwrap();
+    assert_eq!(families.length(), 5);
+    let best = families.get(get(&klipper, "best").as_f64().unwrap() as u32);
+    let name = get(&best, "name").as_string().unwrap();
+    let printed = get(&best, "printed");
+    let freq = get(&printed, "freq").as_f64().unwrap();
+    assert!((35.0..60.0).contains(&freq), "{name} {freq}");
+    let ranked: js_sys::Array = get(&r, "ranked").dyn_into().unwrap();
+    let rec = ranked.get(get(&r, "recommended").as_f64().unwrap() as u32);
+    assert_eq!(get(&rec, "family").as_string(), Some(name));
+    // Normalised twice is a different spectrum: the flag is read.
+    set(&spectrum, "normalization", &"klipper".into());
+    let r2 = api::recommend_shaper(spectrum.clone().into(), JsValue::NULL, options.clone());
+    assert!(r2.is_ok());
+    set(&spectrum, "normalization", &"twice".into());
+    let e: js_sys::Error = api::recommend_shaper(spectrum.into(), JsValue::NULL, options)
+        .unwrap_err()
+        .dyn_into()
+        .unwrap();
+    let field = get(&e, "field").as_string().unwrap_or_default();
+    assert!(field.starts_with("spectrum.normalization"), "{field}");
+}

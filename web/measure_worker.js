@@ -4,10 +4,10 @@
 // options }, { id, type: 'analyse', options } and { id, type: 'fft', channel }; out: progress,
 // result ({ recording, identification, recommendation, rankingError }), fft ({ spectrum }) or
 // error ({ message, line, column }). Reading and identifying use the worker's own small module
-// (pkg/page/recording.js); the ranking designs every candidate shaper, which only the page's
-// module can, so the page hands over that module, already compiled (nothing fetched again).
-import initRecording, { RecordingParser, identifyModes, fftSpectrum } from '../pkg/page/recording.js';
-import initPlayground, { recommendShaper } from '../pkg/page/playground.js';
+// (pkg/page/recording.js), and so does the ranking (recommendShaper moved there with Klipper's
+// fit, off the page's first load). The page still hands over its own module, compiled.
+import initRecording, { RecordingParser, identifyModes, fftSpectrum, recommendShaper } from '../pkg/page/recording.js';
+import initPlayground from '../pkg/page/playground.js';
 
 const CHUNK_BYTES = 1 << 20;
 const ready = initRecording();

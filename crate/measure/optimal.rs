@@ -1055,8 +1055,8 @@ pub fn optimal(
 }
 
 /// `criterion: "optimal"` of [`super::recommend::recommend`]: the measured `spectrum` read as
-/// Klipper reads a PSD it computed or a `resonances_*.csv` (normalised with
-/// [`CalibrationData::normalize_to_frequencies`]), [`optimal`] run for `options.firmware`, and
+/// Klipper reads it ([`super::recommend::calibration_data`]: its runs, normalised unless it
+/// says it is), [`optimal`] run for `options.firmware`, and
 /// its table as the ranked candidates: the recommended one (custom for a custom-shaper
 /// firmware, else the best mainline one) first, then the others by Klipper's score. Each
 /// candidate's `spec` is its impulse sequence (`custom`), `remainingVibration` and
@@ -1067,16 +1067,7 @@ pub fn recommend_optimal(
     options: &super::recommend::RecommendOptions,
 ) -> Result<super::recommend::Recommendation> {
     use super::recommend::{Candidate, Criterion, Recommendation};
-    let run = super::klipper::Dataset::new(
-        "spectrum",
-        spectrum.frequency_hz.clone(),
-        spectrum.psd.clone(),
-        None,
-        false,
-    )
-    .map_err(|e| e.within("spectrum"))?;
-    let mut data = CalibrationData::new(run);
-    data.normalize_to_frequencies();
+    let data = super::recommend::calibration_data(spectrum)?;
     let report = optimal(
         &data,
         modes,
@@ -1136,6 +1127,7 @@ pub fn recommend_optimal(
         damping_tested: report.damping_tested,
         frequency_factors: report.frequency_factors,
         band_hz: [0.0, super::klipper::fit::MAX_FREQ],
+        klipper: None,
         note: Some(report.note),
     })
 }

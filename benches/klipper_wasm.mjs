@@ -1,0 +1,60 @@
+// Klipper's recommendation in wasm (issue 20 item 7): a spectrum file of the test set to
+// recommendShaper(spectrum, [], { criterion: 'klipper' }) in the measured-data worker's module,
+// timed in node. The file is read here with a few lines of JS (the product reads it with
+// parseRecording); the figure is the fit.
+//
+//   bash scripts/build.sh   # or any --target web build of the js-recording feature
+//   node benches/klipper_wasm.mjs [path/to/recording.js] [files…]
+//
+// Prints, per file, the median and minimum of 20 runs after 3 warm-ups (wall clock and the
+// process's CPU time, which a busy machine inflates less), and the pick.
+import { readFileSync } from 'node:fs';
+import { fileURLToPath } from 'node:url';
+import path from 'node:path';
+
+const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
+const args = process.argv.slice(2);
+const modulePath = path.resolve(args[0] ?? path.join(root, 'pkg/page/recording.js'));
+const files = args.length > 1 ? args.slice(1) : [
+  'resonances_x_m1.csv', 'resonances_x_z018f61.csv', 'resonances_y_z020f61.csv',
+  'calibration_data_x_m1.csv',
+];
+const mod = await import(modulePath);
+const wasm = readFileSync(modulePath.replace(/\.js$/, '_bg.wasm'));
+await mod.default({ module_or_path: wasm });
+
+/** A Klipper `freq,psd_x,psd_y,psd_z,psd_xyz[,shapers:…]` file as a spectrum object. */
+function read(name) {
+  const lines = readFileSync(path.join(root, 'tests/data/klipper', name), 'utf8')
+    .split('\n').filter((l) => l && !l.startsWith('#'));
+  const header = lines.shift();
+  const rows = lines.map((l) => l.split(',').map((x) => (x === '' ? 0 : Number(x))));
+  const col = (i) => Float64Array.from(rows, (r) => r[i]);
+  return {
+    frequencyHz: col(0), psdX: col(1), psdY: col(2), psdZ: col(3), psdSum: col(4), psd: col(4),
+    normalization: header.includes(',shapers:') ? 'klipper' : 'none',
+  };
+}
+
+for (const name of files) {
+  const spectrum = read(name);
+  const run = () => mod.recommendShaper(spectrum, [], { criterion: 'klipper' });
+  for (let i = 0; i < 3; i++) run();
+  const times = [];
+  const cpu = [];
+  let r;
+  for (let i = 0; i < 20; i++) {
+    const t0 = performance.now();
+    const c0 = process.cpuUsage();
+    r = run();
+    const c = process.cpuUsage(c0);
+    times.push(performance.now() - t0);
+    cpu.push((c.user + c.system) / 1000);
+  }
+  times.sort((a, b) => a - b);
+  cpu.sort((a, b) => a - b);
+  const best = r.klipper.families[r.klipper.best];
+  console.log(`${name}: median ${times[10].toFixed(1)} ms, min ${times[0].toFixed(1)} ms `
+    + `(CPU time: median ${cpu[10].toFixed(1)} ms, min ${cpu[0].toFixed(1)} ms) `
+    + `(${spectrum.frequencyHz.length} bins) → ${best.name} @ ${best.printed.freq} Hz`);
+}
