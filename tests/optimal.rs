@@ -264,6 +264,7 @@ fn recommend_criterion_optimal_ranks_the_optimised_shaper_first() {
     let spectrum = MeasuredSpectrum {
         frequency_hz: rows.iter().map(|r| r[0]).collect(),
         psd: rows.iter().map(|r| r[4]).collect(),
+        ..MeasuredSpectrum::default()
     };
     let options = RecommendOptions {
         criterion: Criterion::Optimal,
