@@ -43,10 +43,13 @@ def modal_h2(f, modes):
     return np.abs(h) ** 2
 
 
+def _exp(x):
+    return math.exp(min(max(x, -80.0), 80.0))
+
+
 def unpack(p, n):
-    modes = [(math.exp(p[3 * i]), math.exp(p[3 * i + 1]), math.exp(p[3 * i + 2]))
-             for i in range(n)]
-    return modes, math.exp(p[3 * n]), math.exp(p[3 * n + 1])
+    modes = [(_exp(p[3 * i]), _exp(p[3 * i + 1]), _exp(p[3 * i + 2])) for i in range(n)]
+    return modes, _exp(p[3 * n]), _exp(p[3 * n + 1])
 
 
 def kaiser_kernel(fs, m, sub=16, reach=6):
@@ -118,7 +121,7 @@ def fit_frf(freqs, hmeas, weight, n, band, starts_f):
         p0 += [0.0]
 
         def resid(p):
-            modes = [(math.exp(p[3 * i]), math.exp(p[3 * i + 1]), math.exp(p[3 * i + 2]))
+            modes = [(_exp(p[3 * i]), _exp(p[3 * i + 1]), _exp(p[3 * i + 2]))
                      for i in range(n)]
             s = 2j * math.pi * f
             hm = np.ones_like(s)

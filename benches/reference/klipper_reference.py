@@ -172,6 +172,40 @@ def shaper_3hump_ei(f, zeta):
     return _hump(_EI3_T, _EI3_A, f, zeta)
 
 
+# The EI family as Klipper defined it before its polynomial fits (shaper_defs.py at
+# b50fc9e359239370fc3eeecdf3f971369d32b356, 2020-2021, and releases up to at least 2023):
+# impulses at half periods of the damped frequency, each later one scaled by
+# k = exp(-zeta pi / sqrt(1 - zeta^2)) per half period, undamped weights from the vibration
+# tolerance V = 1/20 (Singhose's closed forms).
+def _classic_k(f, zeta):
+    root, td = _damped(f, zeta)
+    return math.exp(-zeta * math.pi / root), td
+
+
+def shaper_ei_classic(f, zeta, v=1.0 / SHAPER_VIBRATION_REDUCTION):
+    k, td = _classic_k(f, zeta)
+    a1 = 0.25 * (1.0 + v)
+    return [a1, 0.5 * (1.0 - v) * k, a1 * k * k], [0.0, 0.5 * td, td]
+
+
+def shaper_2hump_ei_classic(f, zeta, v=1.0 / SHAPER_VIBRATION_REDUCTION):
+    k, td = _classic_k(f, zeta)
+    v2 = v * v
+    x = (v2 * (math.sqrt(1.0 - v2) + 1.0)) ** (1.0 / 3.0)
+    a1 = (3.0 * x * x + 2.0 * x + 3.0 * v2) / (16.0 * x)
+    a2 = (0.5 - a1) * k
+    return [a1, a2, a2 * k, a1 * k ** 3], [0.0, 0.5 * td, td, 1.5 * td]
+
+
+def shaper_3hump_ei_classic(f, zeta, v=1.0 / SHAPER_VIBRATION_REDUCTION):
+    k, td = _classic_k(f, zeta)
+    a1 = 0.0625 * (1.0 + 3.0 * v + 2.0 * math.sqrt(2.0 * (v + 1.0) * v))
+    a2 = 0.25 * (1.0 - v) * k
+    a3 = (0.5 * (1.0 + v) - 2.0 * a1) * k * k
+    return ([a1, a2, a3, a2 * k * k, a1 * k ** 4],
+            [0.0, 0.5 * td, td, 1.5 * td, 2.0 * td])
+
+
 # name -> (constructor, lowest frequency scanned by default)
 SHAPERS = {
     "zv": (shaper_zv, 21.0),
@@ -181,6 +215,10 @@ SHAPERS = {
     "2hump_ei": (shaper_2hump_ei, 39.0),
     "3hump_ei": (shaper_3hump_ei, 48.0),
 }
+SHAPERS_CLASSIC = dict(SHAPERS, ei=(shaper_ei_classic, 29.0),
+                       **{"2hump_ei": (shaper_2hump_ei_classic, 39.0),
+                          "3hump_ei": (shaper_3hump_ei_classic, 48.0)})
+DEFS = {"current": SHAPERS, "classic": SHAPERS_CLASSIC}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -385,9 +423,13 @@ class Result:
 
 
 def fit_family(name, datasets, scv=DEFAULT_SCV, max_smoothing=None, max_vibrations=None,
-               damping_ratio=None, test_damping=None, max_freq=None):
-    """fit_shaper: returns (selected, all results in scan order, top frequency first)."""
-    make, fmin = SHAPERS[name]
+               damping_ratio=None, test_damping=None, max_freq=None, defs="current",
+               legacy=False):
+    """fit_shaper: returns (selected, all results in scan order, top frequency first).
+    legacy=True: the selection rule of the 2021-2023 releases (shaper_calibrate.py at
+    10bceefbf910b8d2e2ada46bb95517e0e043a72a): a result replaces the selection only if its
+    vibrations are < 1.1 x the lowest (no + 0.0005) and its score is lower."""
+    make, fmin = DEFS[defs][name]
     zeta = damping_ratio or DEFAULT_DAMPING_RATIO
     tests = test_damping or TEST_DAMPING_RATIOS
     test_freqs = np.arange(min(fmin, MAX_SHAPER_FREQ - 1e-7), MAX_SHAPER_FREQ, 0.2)
@@ -423,7 +465,7 @@ def fit_family(name, datasets, scv=DEFAULT_SCV, max_smoothing=None, max_vibratio
     # lowest wins if its score is lower; scanned from the lowest frequency up.
     chosen = best
     for res in reversed(results):
-        if res.vibrs < best.vibrs * 1.1 + 0.0005 and (
+        if res.vibrs < best.vibrs * 1.1 + (0.0 if legacy else 0.0005) and (
                 res.score < chosen.score
                 or (max_vibrations is not None and best.vibrs > max_vibrations)):
             chosen = res
@@ -432,14 +474,16 @@ def fit_family(name, datasets, scv=DEFAULT_SCV, max_smoothing=None, max_vibratio
 
 def best_shaper(datasets, shapers=None, scv=DEFAULT_SCV, max_smoothing=None,
                 max_vibrations=None, damping_ratio=None, test_damping=None, max_freq=None,
-                log=None):
-    """find_best_shaper: returns (best, per-family picks in order, per-family scans)."""
+                log=None, defs="current", legacy=False):
+    """find_best_shaper: returns (best, per-family picks in order, per-family scans).
+    legacy=True: as the 2021-2023 releases: only the 20 % / 5 %+10 % rule between families
+    (no replacement by other scanned frequencies, no zv fallback)."""
     best = None
     picks = []
     scans = {}
     for name in shapers or AUTOTUNE_SHAPERS:
         chosen, results = fit_family(name, datasets, scv, max_smoothing, max_vibrations,
-                                     damping_ratio, test_damping, max_freq)
+                                     damping_ratio, test_damping, max_freq, defs, legacy)
         scans[name] = results
         if (best is None or chosen.score * 1.2 < best.score
                 or (chosen.score * 1.05 < best.score
@@ -449,7 +493,7 @@ def best_shaper(datasets, shapers=None, scv=DEFAULT_SCV, max_smoothing=None,
             best = chosen
         # Any scanned frequency of this family (lowest first) with both fewer vibrations and
         # less smoothing than the current best replaces it, and becomes this family's pick.
-        for res in reversed(results):
+        for res in ([] if legacy else reversed(results)):
             if res.vibrs < best.vibrs and res.smoothing < best.smoothing:
                 best = chosen = res
         if log:
@@ -458,7 +502,7 @@ def best_shaper(datasets, shapers=None, scv=DEFAULT_SCV, max_smoothing=None,
             log("To avoid too much smoothing with '%s', suggested max_accel <= %.0f mm/sec^2"
                 % (chosen.name, round(chosen.max_accel / 100.0) * 100.0))
         picks.append(chosen)
-    if best is not None and best.name == "zv":
+    if best is not None and best.name == "zv" and not legacy:
         for p in picks:
             if p.name != "zv" and p.vibrs * 1.1 < best.vibrs:
                 best = p
@@ -529,7 +573,8 @@ def write_raw_csv(path, t, ax, ay, az):
 # ---------------------------------------------------------------------------------------------
 
 def run(paths, scv=DEFAULT_SCV, max_smoothing=None, max_vibrs_pcnt=None, shapers=None,
-        max_freq=None, damping_ratio=None, test_damping=None, log=print, detail=False):
+        max_freq=None, damping_ratio=None, test_damping=None, log=print, detail=False,
+        defs="current", legacy=False):
     datasets = []
     for p in paths:
         datasets.extend(parse_file(p))
@@ -537,14 +582,16 @@ def run(paths, scv=DEFAULT_SCV, max_smoothing=None, max_vibrs_pcnt=None, shapers
         log("Processing resonances from %s" % ",".join(d.name for d in datasets))
     max_vibrations = None if max_vibrs_pcnt is None else max_vibrs_pcnt * 0.01
     best, picks, _ = best_shaper(datasets, shapers, scv, max_smoothing, max_vibrations,
-                                 damping_ratio, test_damping, max_freq, log)
+                                 damping_ratio, test_damping, max_freq, log, defs, legacy)
     if log:
         log("Recommended shaper is %s @ %.1f Hz" % (best.name, best.freq))
     out = {
         "files": list(paths),
         "options": {"scv": scv, "max_smoothing": max_smoothing,
                     "max_vibrs_pcnt": max_vibrs_pcnt, "shapers": list(shapers or AUTOTUNE_SHAPERS),
-                    "max_freq": max_freq, "damping_ratio": damping_ratio or DEFAULT_DAMPING_RATIO},
+                    "max_freq": max_freq, "damping_ratio": damping_ratio or DEFAULT_DAMPING_RATIO,
+                    "test_damping_ratios": list(test_damping or TEST_DAMPING_RATIOS),
+                    "defs": defs, "legacy_selection": legacy},
         "datasets": [{"name": d.name, "kind": getattr(d, "kind", "?"), "bins": int(d.freqs.size),
                       "normalized_on_read": getattr(d, "kind", "") != "calibration_data"}
                      for d in datasets],
@@ -607,16 +654,21 @@ def main(argv=None):
     ap.add_argument("--damping_ratio", type=float)
     ap.add_argument("--test_damping_ratios")
     ap.add_argument("--csv", help="write a calibration_data CSV as calibrate_shaper.py -c does")
+    ap.add_argument("--defs", choices=sorted(DEFS), default="current",
+                    help="shaper definitions: current (polynomial-fit EI forms) or classic "
+                         "(the closed-form EI of the 2021-2023 releases)")
+    ap.add_argument("--legacy", action="store_true",
+                    help="the 2021-2023 selection rules (see fit_family, best_shaper)")
     a = ap.parse_args(argv)
     shapers = a.shapers.lower().split(",") if a.shapers else None
     tdr = [float(x) for x in a.test_damping_ratios.split(",")] if a.test_damping_ratios else None
     out = run(a.files, a.scv, a.max_smoothing, a.max_vibrs_pcnt, shapers, a.max_freq,
-              a.damping_ratio, tdr)
+              a.damping_ratio, tdr, defs=a.defs, legacy=a.legacy)
     if a.csv:
         datasets = [d for p in a.files for d in parse_file(p)]
         mv = None if a.max_vibrs_pcnt is None else a.max_vibrs_pcnt * 0.01
         _, picks, _ = best_shaper(datasets, shapers, a.scv, a.max_smoothing, mv,
-                                  a.damping_ratio, tdr, a.max_freq)
+                                  a.damping_ratio, tdr, a.max_freq, None, a.defs, a.legacy)
         write_calibration_csv(a.csv, datasets, picks)
     if a.json:
         with open(a.json, "w") as fh:

@@ -32,9 +32,12 @@ and the accelerometer on the toolhead measures  y'' = a_cmd + sum_i g_i e_i''.
 For one mode with g = 1 this is the base-excitation transmissibility
     Y''/A(s) = (2 zeta w s + w^2) / (s^2 + 2 zeta w s + w^2);
 in general H(s) = 1 - sum_i g_i s^2 / (s^2 + 2 zeta_i w_i s + w_i^2).  The modal gain g_i is
-a participation factor (< 1 for a mode that only part of the structure takes part in); the
-peak of mode i's term is about g_i / (2 zeta_i).  The manifest gives each mode's f, zeta, g,
-and peak_db = 20 log10(g / (2 zeta)).
+a participation factor; the g_i sum to 1 (the absolute acceleration of a point of a
+base-excited structure: sum_i Gamma_i phi_i = 1), so H(0) = 1 and H falls off above the
+modes, H = sum_i g_i (2 zeta_i w_i s + w_i^2) / (s^2 + 2 zeta_i w_i s + w_i^2).  The peak of
+mode i is about g_i / (2 zeta_i); cases give the modes' peaks relative to each other (e.g.
+4 dB), the g_i follow.  The manifest gives each mode's f, zeta, g and
+peak_db = 20 log10(g / (2 zeta)).
 Integration is EXACT: a_cmd is constant between its switching times, so over every interval
 between consecutive events (sample instants and switching times) each mode's state advances
 by the closed-form solution of the damped oscillator under a constant input (the matrix
@@ -70,6 +73,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import klipper_reference as kr  # noqa: E402
 
 G = 9806.65
+# sensor drift (mm/s^2, s): offset, slope per second, a slow sine; per channel k = 0, 1, 2 the
+# offset is scaled by (1 - k/2), the slope by (1 + k), the sine's phase shifted by k rad
+DRIFT = {"offset": 60.0, "slope": 3.0, "sine": 25.0, "period": 40.0}
 SCALE_XY = 0.003774 * G
 SCALE_Z = 0.003906 * G
 MOUNT_DEG = 2.0
@@ -225,7 +231,7 @@ def record(case):
     rng = np.random.default_rng(case["seed"])
     sig = case["noise"]
     span = t[-1]
-    drift = case.get("drift", {"offset": 60.0, "slope": 3.0, "sine": 25.0, "period": 40.0})
+    drift = case.get("drift", DRIFT)
 
     def drift_of(k):
         return (drift["offset"] * (1 - 0.5 * k) + drift["slope"] * t * (1 + k)
@@ -287,12 +293,22 @@ def write_files(case, outdir):
 # Cases
 # ---------------------------------------------------------------------------------------------
 
-def mode(f, zeta, peak_db=None, gain=None):
-    """A mode by frequency, damping and either its gain or its peak g / (2 zeta) in dB."""
-    if gain is None:
-        gain = 2.0 * zeta * 10 ** (peak_db / 20.0)
-    return {"f": f, "zeta": zeta, "gain": gain,
-            "peak_db": 20 * math.log10(gain / (2 * zeta))}
+def mode(f, zeta, rel_db=0.0):
+    """A mode by frequency, damping and its peak relative to the case's other modes (dB);
+    the gains are set by normalize_gains."""
+    return {"f": f, "zeta": zeta, "rel_db": rel_db}
+
+
+def normalize_gains(modes):
+    """Participation factors g_i summing to 1 (so H(0) = 1 and H -> 0 above the modes, as for
+    the absolute acceleration of a point of a base-excited structure: sum_i Gamma_i phi_i = 1),
+    in the ratios that make the peaks g_i / (2 zeta_i) differ by the rel_db given."""
+    w = [2.0 * m["zeta"] * 10 ** (m["rel_db"] / 20.0) for m in modes]
+    for m, wi in zip(modes, w):
+        m["gain"] = wi / sum(w)
+        m["peak_db"] = 20 * math.log10(m["gain"] / (2 * m["zeta"]))
+        del m["rel_db"]
+    return modes
 
 
 def exc(fs, fe, aph=60.0, hps=1.0, sacc=400.0, sper=1.2):
@@ -314,7 +330,7 @@ def cases():
                   modes=[mode(38.0, 0.04, 16.0), mode(53.2, 0.04, 12.0)],
                   excitation=exc(33.0, 58.0, hps=2.0),
                   outputs=["raw", "resonances", "calibration_data"],
-                  note="two modes, ratio 1.4, the second 4 dB weaker (peak_db 16 vs 12)"))
+                  note="two modes, ratio 1.4, the second's peak 4 dB below the first's"))
     c.append(dict(name="z018f61", axis="x", rate=3200.0, seed=104, noise=150.0,
                   modes=[mode(61.0, 0.18, 9.0)], excitation=exc(40.0, 90.0, hps=5.0),
                   outputs=["raw", "resonances"],
@@ -355,6 +371,14 @@ def cases():
     c.append(dict(name="noisy47", axis="y", rate=3200.0, seed=208, noise=400.0,
                   modes=[mode(47.3, 0.08, 14.0)], excitation=FULL, outputs=["resonances"],
                   note="single mode, noise 400 mm/s^2 (PSD floor ~100); " + full))
+    for case in c:
+        normalize_gains(case["modes"])
+        case.setdefault("drift", dict(DRIFT))
+        if case["name"] == "z001f88":
+            # a peak of 1/(2 zeta) = 50 would clip the sensor at Klipper's default 60
+            # mm/s^2/Hz: the test is run with ACCEL_PER_HZ=20
+            case["excitation"] = exc(5.0, 200.0, aph=20.0)
+            case["note"] += "; ACCEL_PER_HZ=20"
     return c
 
 
@@ -366,14 +390,57 @@ def case_key(case):
 COMBINED = {"resonances_x_m1+resonances_x_m1run2": ["x_m1", "x_m1run2"]}
 
 
+# expected.json keys "<file>|<option>=<value>": the reference output with calibrate_shaper.py's
+# options (the same names as its command line)
+VARIANTS = [
+    ("resonances_y_z003f23.csv", {"max_smoothing": 0.2}),
+    ("resonances_y_three.csv", {"max_vibrs_pcnt": 1.0}),
+    ("resonances_x_m1.csv", {"scv": 10.0}),
+    ("resonances_x_z008f47.csv", {"shapers": ["zvd", "mzv", "zv"]}),
+    ("resonances_x_z001f88.csv", {"damping_ratio": 0.05, "test_damping_ratios": [0.01, 0.02]}),
+] + [
+    # the closed-form EI shapers of the releases before the polynomial fits (defs=classic),
+    # and with them the 2021-2023 selection rule (legacy=True)
+    (fn, {"defs": "classic"}) for fn in (
+        "resonances_x_m1.csv", "resonances_y_m1.csv", "resonances_y_three.csv",
+        "resonances_x_two45x14.csv", "resonances_y_z003f23.csv", "resonances_x_z001f88.csv",
+        "resonances_y_z020f61.csv", "resonances_x_z008f47.csv")
+] + [
+    (fn, {"defs": "classic", "legacy": True}) for fn in (
+        "resonances_x_m1.csv", "resonances_y_m1.csv", "resonances_y_three.csv")
+]
+
+
+def readme_table(manifest_path):
+    man = json.load(open(manifest_path))["cases"]
+    rows = ["| case (axis_name) | files | rate, length | excitation | noise | "
+            "true modes f / ζ / g / peak dB |", "| --- | --- | --- | --- | --- | --- |"]
+    for k, v in sorted(man.items(), key=lambda kv: (kv[1]["excitation"]["freq_end"] != 200,
+                                                     kv[0])):
+        ex = v["excitation"]
+        files = ", ".join(x for x in ("raw", "resonances", "calibration_data") if x in v["files"])
+        exs = "%g–%g Hz, %g Hz/s, %g mm/s²/Hz%s" % (
+            ex["freq_start"], ex["freq_end"], ex["hz_per_sec"], ex["accel_per_hz"],
+            ", slow sweep" if ex["sweeping_period"] else ", no slow sweep")
+        modes = "; ".join("%g / %g / %.3f / %.1f" % (m["f"], m["zeta"], m["gain"], m["peak_db"])
+                          for m in v["modes"])
+        rows.append("| %s | %s | %g Hz, %.1f s | %s | %g | %s |" % (
+            k, files, v["rate"], v["duration_s"], exs, v["noise"], modes))
+    print("\n".join(rows))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(os.path.dirname(__file__), "..", "..",
                                                   "tests", "data", "klipper"))
     ap.add_argument("--only")
+    ap.add_argument("--readme-table", action="store_true",
+                    help="print the README's table of cases from the manifest and stop")
     ap.add_argument("--expected-only", action="store_true",
                     help="recompute expected.json from the files in the manifest, simulate nothing")
     a = ap.parse_args(argv)
+    if a.readme_table:
+        return readme_table(os.path.join(a.out, "manifest.json"))
     self_check()
     os.makedirs(a.out, exist_ok=True)
     only = set(a.only.split(",")) if a.only else None
@@ -394,7 +461,9 @@ def main(argv=None):
     doc = {
         "generator": "benches/reference/sweep_testset.py",
         "model": "base-excited modes: e_i'' + 2 zeta_i w_i e_i' + w_i^2 e_i = -a_cmd; "
-                 "sensor y'' = a_cmd + sum g_i e_i''; peak_db = 20 log10(g / (2 zeta))",
+                 "sensor y'' = a_cmd + sum g_i e_i'', sum g_i = 1, so Y''/A = "
+                 "sum g_i (2 zeta_i w_i s + w_i^2) / (s^2 + 2 zeta_i w_i s + w_i^2); "
+                 "peak_db = 20 log10(g / (2 zeta)); accelerations in mm/s^2, f in Hz",
         "cases": manifest,
     }
     with open(manifest_path, "w") as fh:
@@ -409,6 +478,19 @@ def main(argv=None):
                 out["files"] = [fn]
                 out["datasets"][0]["name"] = fn
                 expected[fn] = out
+    for fn, opts in VARIANTS:
+        if not os.path.exists(os.path.join(a.out, fn)):
+            continue
+        kw = dict(opts)
+        if "test_damping_ratios" in kw:
+            kw["test_damping"] = kw.pop("test_damping_ratios")
+        out = kr.run([os.path.join(a.out, fn)], log=None, detail=False, **kw)
+        out["files"] = [fn]
+        out["datasets"][0]["name"] = fn
+        key = fn + "|" + ",".join("%s=%s" % (k, v if not isinstance(v, list) else
+                                             ":".join(str(x) for x in v))
+                                  for k, v in sorted(opts.items()))
+        expected[key] = out
     # Several files of one axis, combined as calibrate_shaper.py combines them (one data set
     # each, the worst remaining vibration over them), and the multi-data-set calibration file
     # that calibrate_shaper.py -c writes for them.
