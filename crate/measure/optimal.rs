@@ -71,7 +71,7 @@ pub const VIBRATION_ALLOWANCE: f64 = 0.05;
 /// frequency uncertainty widens it.
 pub const DEFAULT_FREQUENCY_BAND: f64 = 0.0;
 /// Damping ratios of the mainline scan (each family up to its `max_damping_ratio`).
-const DAMPING_GRID: [f64; 4] = [0.05, 0.1, 0.15, 0.25];
+const DAMPING_GRID: [f64; 7] = [0.05, 0.075, 0.1, 0.125, 0.15, 0.2, 0.25];
 /// Relative step of the mainline frequency scan (refined afterwards by a pattern search).
 const FREQUENCY_STEP: f64 = 0.02;
 /// Local minima of each family's scan refined.
