@@ -513,13 +513,19 @@ pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, J
 /// `identifyModes(…).spectrum` or a parsed Klipper spectrum file), `modes = [{ frequencyHz,
 /// damping, frequencyUncertaintyHz?, dampingUncertainty? }]` (e.g. `identifyModes(…).modes`;
 /// not used by `criterion: 'klipper'`), options `{ families?: [{ family, … }], criterion?:
-/// 'duration' | 'klipper', maxRemainingVibration?, scv?, uncertaintySigmas?, minFrequencyHz?,
+/// 'duration' | 'klipper' | 'optimal', firmware?: 'klipper' | 'kalico' | 'reprapfirmware',
+/// maxRemainingVibration?, scv?, uncertaintySigmas?, minFrequencyHz?,
 /// maxFrequencyHz?, shapers?, dampingRatio?, maxSmoothing?, maxVibrations?,
 /// testDampingRatios?, shaperFrequencies?, shaperFrequencyRange?: { start?, end?, step? } }` →
 /// `{ criterion, recommended, ranked: [{ label, family, spec, modes, shaper, durationS,
 /// remainingVibration, nominalRemainingVibration, smoothing, maxAccel, klipperScore,
 /// acceptable }], dampingTested, frequencyFactors, bandHz, klipper? }` (`klipper`: Klipper's
-/// table, see crate::measure::recommend). In the measured-data worker's module (js-recording).
+/// table, see crate::measure::recommend). `criterion: 'optimal'`: the shaper optimised for the
+/// spectrum by Klipper's own score, never worse than Klipper's pick (crate::measure::optimal) —
+/// for `firmware: 'klipper'` the best mainline family × frequency × damping ratio, else a
+/// custom impulse sequence within the firmware's limits — ranked first, then the rest of its
+/// table (Klipper's own pick among them), with `note` saying what it bought. In the
+/// measured-data worker's module (js-recording).
 #[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = recommendShaper)]
 pub fn recommend_shaper(

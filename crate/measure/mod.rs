@@ -15,6 +15,7 @@ pub mod fft;
 mod fit;
 pub mod identify;
 pub mod klipper;
+pub mod optimal;
 pub mod psd;
 pub mod recommend;
 pub mod recording;

@@ -137,6 +137,10 @@ pub enum Criterion {
     Duration,
     /// Klipper's own recommendation, reproduced (see the module docs).
     Klipper,
+    /// The shaper optimised for the spectrum by Klipper's own score, never worse than
+    /// Klipper's pick ([`super::optimal`]); `firmware` says which kind (mainline Klipper's
+    /// family × frequency × damping ratio, or a custom impulse sequence).
+    Optimal,
 }
 
 /// Options of [`recommend`] (JS: `{ families, criterion, maxRemainingVibration, scv,
@@ -176,6 +180,9 @@ pub struct RecommendOptions {
     /// Klipper's scan as a range (`--shaper_freq start:end:step`; a missing bound is Klipper's
     /// default).
     pub shaper_frequency_range: Option<FrequencyRange>,
+    /// With `criterion: "optimal"`: the firmware (`klipper`, `kalico`, `reprapfirmware`;
+    /// default `klipper`).
+    pub firmware: super::optimal::Firmware,
 }
 
 /// A scan range, Hz (`{ start?, end?, step? }`).
@@ -207,6 +214,7 @@ impl Default for RecommendOptions {
             test_damping_ratios: None,
             shaper_frequencies: None,
             shaper_frequency_range: None,
+            firmware: super::optimal::Firmware::Klipper,
         }
     }
 }
@@ -285,6 +293,9 @@ pub struct Recommendation {
     /// With `criterion: "klipper"`: Klipper's table as `calibrate_shaper` prints it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub klipper: Option<KlipperFit>,
+    /// With `criterion: "optimal"`: what the optimisation bought, in words.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 /// Klipper's remaining vibration R of `shaper` over bins (f, P), V at `zeta` and f·`factor`.
@@ -327,6 +338,9 @@ pub fn recommend(
     if options.criterion == Criterion::Klipper {
         return klipper_recommendation(spectrum, options);
     }
+    if options.criterion == Criterion::Optimal {
+        return super::optimal::recommend_optimal(spectrum, modes, options);
+    }
     let scoring = Scoring::new(spectrum, modes, options)?;
     let (candidates, skipped) = design_candidates(&scoring, spectrum, options)?;
     let (ranked, recommended) = rank_by_duration(candidates);
@@ -339,6 +353,7 @@ pub fn recommend(
         frequency_factors: scoring.frequency_factors,
         band_hz: scoring.band_hz,
         klipper: None,
+        note: None,
     })
 }
 
@@ -763,5 +778,6 @@ fn klipper_recommendation(
         frequency_factors: vec![1.0],
         band_hz: [lowest, fit.max_freq],
         klipper: Some(fit),
+        note: None,
     })
 }

@@ -1,0 +1,296 @@
+//! The optimised shapers of issue 25 (crate/measure/optimal.rs) on the independently generated
+//! test set `tests/data/klipper/` (benches/reference/sweep_testset.py):
+//!
+//! 1. the best mainline-Klipper shaper never scores worse than Klipper's own pick and never
+//!    leaves more vibration than max(pick's, 5 %), by Klipper's own scoring (the crate's
+//!    reproduction, itself checked against benches/reference/klipper_reference.py);
+//! 2. the custom shaper scores no worse than the mainline one, within each firmware's limits;
+//! 3. it is not tuned to noise: designed on one run of a machine, its score on the second run
+//!    stays within 10 % of its score on the first;
+//! 4. the mainline search is at least as good as an independent dense grid
+//!    (benches/reference/optimal_reference.py, numpy: `optimal_reference.json`) to 0.5 %.
+//!
+//! Native only (reads files).
+
+use input_shaping::measure::klipper::{
+    find_best_shaper, klipper_figures_on, CalibrationData, Channel, Dataset, FitOptions,
+};
+use input_shaping::measure::optimal::{
+    optimal, Firmware, OptimalOptions, OptimalReport, MIN_CUSTOM_AMPLITUDE,
+};
+use input_shaping::measure::recommend::MeasuredMode;
+use input_shaping::shaper::Shaper;
+use std::path::Path;
+
+const DIR: &str = "tests/data/klipper";
+
+/// A `resonances_*.csv` (`freq,psd_x,psd_y,psd_z,psd_xyz`) read and normalised as Klipper's
+/// `calibrate_shaper.py` reads it (minimal reader; the product's is `parseRecording`).
+fn read(name: &str) -> CalibrationData {
+    let text = std::fs::read_to_string(Path::new(DIR).join(name)).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(
+        header.starts_with("freq,psd_x,psd_y,psd_z,psd_xyz"),
+        "{name}"
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let col = |i: usize| rows.iter().map(|r| r[i]).collect::<Vec<f64>>();
+    let mut d = CalibrationData::new(
+        Dataset::new(name, col(0), col(4), Some([col(1), col(2), col(3)]), false).unwrap(),
+    );
+    d.normalize_to_frequencies();
+    d
+}
+
+fn run(name: &str, firmware: Firmware) -> (CalibrationData, OptimalReport) {
+    let data = read(name);
+    let options = OptimalOptions {
+        firmware,
+        ..OptimalOptions::default()
+    };
+    let r = optimal(&data, &[], &options).unwrap();
+    (data, r)
+}
+
+/// The guarantees of items 1 and 2 on one file.
+fn check(name: &str, firmware: Firmware) -> OptimalReport {
+    let (data, r) = run(name, firmware);
+    // Row 0 is Klipper's own pick.
+    let fit = find_best_shaper(&data, &FitOptions::default()).unwrap();
+    let best = &fit.families[fit.best];
+    let pick = &r.rows[0];
+    assert_eq!(pick.kind, "klipper");
+    assert_eq!(pick.family, best.name, "{name}");
+    assert_eq!(pick.shaper_freq_hz, Some(best.pick.freq), "{name}");
+    assert!((pick.klipper.score - best.pick.score).abs() <= 1e-12 * best.pick.score);
+    // Every row's figures are Klipper's own, recomputed here on the row's impulses.
+    for row in &r.rows {
+        let s = Shaper::new(row.shaper.impulses.clone()).unwrap();
+        let f = klipper_figures_on(&s, &data, None, 5.0, None, Channel::Sum).unwrap();
+        assert!(
+            (f.score - row.klipper.score).abs() <= 1e-12 * f.score,
+            "{name}"
+        );
+        assert!(
+            (f.vibrations - row.klipper.vibrations).abs() <= 1e-12,
+            "{name}"
+        );
+    }
+    let cap = pick.klipper.vibrations.max(0.05) + 1e-12;
+    let main = &r.rows[1];
+    assert_eq!(main.kind, "mainline");
+    assert!(
+        main.klipper.score <= pick.klipper.score * (1.0 + 1e-12),
+        "{name}: mainline {} > pick {}",
+        main.klipper.score,
+        pick.klipper.score
+    );
+    assert!(main.klipper.vibrations <= cap, "{name}");
+    assert!(main.improvement >= -1e-12);
+    if let Some(limits) = firmware.limits() {
+        let custom = &r.rows[2];
+        assert_eq!(custom.kind, "custom");
+        assert!(
+            custom.klipper.score <= main.klipper.score * (1.0 + 1e-12),
+            "{name}: custom {} > mainline {}",
+            custom.klipper.score,
+            main.klipper.score
+        );
+        assert!(custom.klipper.vibrations <= cap, "{name}");
+        let imps = &custom.shaper.impulses;
+        assert!(
+            imps.len() >= 2 && imps.len() <= limits.max_impulses,
+            "{name}"
+        );
+        let sum: f64 = imps.iter().map(|i| i.amplitude).sum();
+        assert!((sum - 1.0).abs() < 1e-9);
+        assert!(imps
+            .iter()
+            .all(|i| i.amplitude >= MIN_CUSTOM_AMPLITUDE * (1.0 - 1e-9)));
+        let duration = imps.last().unwrap().time;
+        assert!(duration <= limits.max_duration_s && duration >= limits.min_duration_s);
+        assert!(imps.windows(2).all(|w| w[1].time > w[0].time));
+        match firmware {
+            Firmware::Reprapfirmware => assert!(custom.config.starts_with("M593 P\"custom\" H")),
+            _ => assert!(custom.config.contains("shaper_type_x: custom")),
+        }
+        assert_eq!(r.recommended, 2);
+    } else {
+        assert_eq!(r.rows.len(), 2);
+        assert_eq!(r.recommended, 1);
+    }
+    assert!(!r.note.is_empty());
+    r
+}
+
+#[test]
+fn guarantees_single_modes() {
+    for name in [
+        "resonances_x_z008f47.csv",
+        "resonances_x_z018f61.csv",
+        "resonances_y_noisy47.csv",
+    ] {
+        check(name, Firmware::Reprapfirmware);
+    }
+}
+
+#[test]
+fn guarantees_several_modes() {
+    for name in ["resonances_y_three.csv", "resonances_x_two45x14.csv"] {
+        check(name, Firmware::Kalico);
+    }
+    // Mainline Klipper only: two rows.
+    check("resonances_y_m1.csv", Firmware::Klipper);
+}
+
+#[test]
+fn guarantees_far_outside_klippers_scan() {
+    // Modes at 1, 3.4 and 11 Hz: Klipper's scan (from 21 Hz up) leaves 64 % of the vibration;
+    // the mainline search goes down to 5 Hz and must cut it (here to under 1 %).
+    let r = check("resonances_x_slow3modes.csv", Firmware::Reprapfirmware);
+    assert!(r.rows[0].klipper.vibrations > 0.5);
+    assert!(r.rows[1].klipper.vibrations < 0.01);
+}
+
+#[test]
+fn robust_across_two_runs_of_one_machine() {
+    // Issue 25 item 5: designed on run 1, scored on run 2 (same machine, other noise).
+    let (_, r) = run("resonances_x_m1.csv", Firmware::Kalico);
+    let run2 = read("resonances_x_m1run2.csv");
+    for row in &r.rows[1..] {
+        let s = Shaper::new(row.shaper.impulses.clone()).unwrap();
+        let f = klipper_figures_on(&s, &run2, None, 5.0, None, Channel::Sum).unwrap();
+        let ratio = f.score / row.klipper.score;
+        assert!(
+            (0.9..=1.1).contains(&ratio),
+            "{}: run 1 {} run 2 {}",
+            row.kind,
+            row.klipper.score,
+            f.score
+        );
+    }
+}
+
+#[test]
+fn at_least_as_good_as_an_independent_dense_grid() {
+    // benches/reference/optimal_reference.py: damping_ratio every 0.025, shaper_freq every
+    // 0.25 Hz over [½, 2] × Klipper's pick frequency, every family, numpy figures.
+    let text = std::fs::read_to_string("benches/reference/optimal_reference.json").unwrap();
+    let rows: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for entry in rows.as_array().unwrap() {
+        let file = entry["file"].as_str().unwrap();
+        if file != "resonances_y_m1.csv" && file != "resonances_x_two45x14.csv" {
+            continue;
+        }
+        let (_, r) = run(file, Firmware::Klipper);
+        let k = entry["klipper"]["score"].as_f64().unwrap();
+        assert!((r.rows[0].klipper.score - k).abs() <= 1e-9 * k, "{file}");
+        let grid = entry["mainline"]["score"].as_f64().unwrap();
+        assert!(
+            r.rows[1].klipper.score <= grid * 1.005,
+            "{file}: ours {} grid {grid}",
+            r.rows[1].klipper.score
+        );
+    }
+}
+
+#[test]
+fn measured_modes_widen_the_damping_set() {
+    let data = read("resonances_x_z008f47.csv");
+    let modes = [MeasuredMode {
+        frequency_hz: 47.0,
+        damping: 0.08,
+        frequency_uncertainty_hz: 0.3,
+        damping_uncertainty: 0.01,
+    }];
+    let r = optimal(&data, &modes, &OptimalOptions::default()).unwrap();
+    for z in [0.06, 0.075, 0.08, 0.1, 0.1, 0.15] {
+        assert!(
+            r.damping_tested.iter().any(|d| (d - z).abs() < 1e-12),
+            "{z} in {:?}",
+            r.damping_tested
+        );
+    }
+    // Still Klipper's guarantees under Klipper's own scoring.
+    assert!(r.rows[1].klipper.score <= r.rows[0].klipper.score * (1.0 + 1e-12));
+}
+
+#[test]
+fn bad_input_is_refused_with_the_field() {
+    let data = read("resonances_x_z008f47.csv");
+    let e = optimal(
+        &data,
+        &[],
+        &OptimalOptions {
+            uncertainty_sigmas: 11.0,
+            ..OptimalOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert_eq!(e.field(), Some("uncertaintySigmas"));
+    let bad = [MeasuredMode {
+        frequency_hz: -1.0,
+        damping: 0.1,
+        frequency_uncertainty_hz: 0.0,
+        damping_uncertainty: 0.0,
+    }];
+    let e = optimal(&data, &bad, &OptimalOptions::default()).unwrap_err();
+    assert!(e.field().unwrap().starts_with("modes[0]"), "{e:?}");
+    let zero = CalibrationData::new(
+        Dataset::new("zero", vec![0.0, 1.0, 2.0], vec![0.0; 3], None, true).unwrap(),
+    );
+    let e = optimal(&zero, &[], &OptimalOptions::default()).unwrap_err();
+    assert!(e.field().is_some(), "{e:?}");
+}
+
+#[test]
+fn recommend_criterion_optimal_ranks_the_optimised_shaper_first() {
+    use input_shaping::measure::optimal::Firmware;
+    use input_shaping::measure::recommend::{
+        recommend, Criterion, MeasuredSpectrum, RecommendOptions,
+    };
+    // The raw (unnormalised) PSD, as identifyModes' spectrum or a resonances file gives it:
+    // recommend normalises it as Klipper does, so Klipper's pick is the golden one.
+    let text = std::fs::read_to_string(Path::new(DIR).join("resonances_x_z008f47.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let spectrum = MeasuredSpectrum {
+        frequency_hz: rows.iter().map(|r| r[0]).collect(),
+        psd: rows.iter().map(|r| r[4]).collect(),
+        ..MeasuredSpectrum::default()
+    };
+    let options = RecommendOptions {
+        criterion: Criterion::Optimal,
+        firmware: Firmware::Reprapfirmware,
+        ..RecommendOptions::default()
+    };
+    let r = recommend(&spectrum, &[], &options).unwrap();
+    assert_eq!(r.criterion, Criterion::Optimal);
+    assert_eq!(r.recommended, 0);
+    assert_eq!(r.ranked.len(), 3);
+    assert_eq!(r.ranked[0].family, "custom");
+    let pick = r
+        .ranked
+        .iter()
+        .find(|c| c.label.contains("Klipper's pick"))
+        .unwrap();
+    let fit = find_best_shaper(&read("resonances_x_z008f47.csv"), &FitOptions::default()).unwrap();
+    let best = &fit.families[fit.best];
+    assert_eq!(pick.family, best.name);
+    let expected = format!("{} {:.1} Hz", best.name, best.pick.freq);
+    assert!(
+        pick.label.starts_with(&expected),
+        "{} vs {expected}",
+        pick.label
+    );
+    let score = |i: usize| r.ranked[i].klipper_score.unwrap();
+    assert!(score(0) <= pick.klipper_score.unwrap());
+    assert!(r.note.as_deref().is_some_and(|n| !n.is_empty()));
+}
