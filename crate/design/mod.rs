@@ -11,6 +11,7 @@
 pub mod direct;
 pub mod quantize;
 pub mod sampled;
+mod solved;
 pub mod specified;
 pub mod zero_vibration;
 
