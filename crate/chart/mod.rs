@@ -2,6 +2,7 @@
 //! canvas (plotters-canvas), native tests into an SVG string they can assert on.
 
 pub mod command;
+mod curves;
 pub mod damping;
 pub mod impulses;
 pub mod map;

@@ -1,7 +1,8 @@
 //! The sensitivity chart: residual vibration V (in %) against frequency, with the tolerable
 //! level Vtol and the modes marked (Singhose 2009 Fig. 7).
 
-use super::{render_error, ChartStyle, Key, Legend};
+use super::curves::{draw_vibration_curves, Axis};
+use super::ChartStyle;
 use crate::error::Result;
 use crate::vibration::SensitivityCurve;
 use plotters::coord::Shift;
@@ -16,82 +17,13 @@ pub fn draw_sensitivity<DB: DrawingBackend>(
     modes_hz: &[f64],
     style: &ChartStyle,
 ) -> Result<()> {
-    area.fill(&WHITE).map_err(render_error)?;
-    let (f_lo, f_hi) = super::finite_range(
-        curves
-            .iter()
-            .flat_map(|(_, c)| c.frequency_hz.iter().copied()),
-        (0.0, 1.0),
-    );
-    let vtol = super::drawable_vtol(vtol);
-    let v_max = curves
+    let curves: Vec<(&str, &[f64], &[f64])> = curves
         .iter()
-        .flat_map(|(_, c)| c.vibration.iter().copied())
-        .filter(|v| v.is_finite())
-        .fold(vtol.unwrap_or(0.0), f64::max)
-        .clamp(1e-3, super::AXIS_LIMIT)
-        * 100.0
-        * 1.06;
-    let mut chart = ChartBuilder::on(area)
-        .caption("Residual vibration V(f)", ("sans-serif", style.font(16.0)))
-        .margin(style.px(10.0))
-        .x_label_area_size(style.px(40.0))
-        .y_label_area_size(style.px(52.0))
-        .build_cartesian_2d(f_lo..f_hi, 0.0..v_max)
-        .map_err(render_error)?;
-    chart
-        .configure_mesh()
-        .x_desc("frequency (Hz)")
-        .y_desc("vibration (%)")
-        .label_style(("sans-serif", style.font(12.0)))
-        .axis_desc_style(("sans-serif", style.font(13.0)))
-        .light_line_style(RGBColor(238, 238, 238))
-        .draw()
-        .map_err(render_error)?;
-    let marker = RGBColor(120, 120, 120);
-    for &f in modes_hz.iter().filter(|f| (f_lo..=f_hi).contains(*f)) {
-        chart
-            .draw_series(LineSeries::new(
-                [(f, 0.0), (f, v_max)],
-                marker.stroke_width(style.px(1.0)),
-            ))
-            .map_err(render_error)?;
-    }
-    let mut keys = Legend::default();
-    if let Some(vtol) = vtol {
-        let red = RGBColor(200, 30, 30);
-        chart
-            .draw_series(LineSeries::new(
-                [(f_lo, vtol * 100.0), (f_hi, vtol * 100.0)],
-                red.stroke_width(style.px(1.0)),
-            ))
-            .map_err(render_error)?;
-        keys.push(
-            format!("Vtol {:.3} %", vtol * 100.0),
-            Key::line(red.stroke_width(2)),
-        );
-    }
-    for (k, (label, curve)) in curves.iter().enumerate() {
-        let color = style.color(k);
-        chart
-            .draw_series(LineSeries::new(
-                curve
-                    .frequency_hz
-                    .iter()
-                    .zip(&curve.vibration)
-                    .filter(|(f, v)| f.is_finite() && v.is_finite())
-                    .map(|(&f, &v)| {
-                        (
-                            super::clip(f, f_lo, f_hi),
-                            super::clip(v * 100.0, 0.0, v_max),
-                        )
-                    }),
-                color.stroke_width(style.px(2.0)),
-            ))
-            .map_err(render_error)?;
-        keys.push(label.to_string(), Key::line(color.stroke_width(3)));
-    }
-    keys.draw_default(&chart, SeriesLabelPosition::UpperRight, style)?;
-    area.present().map_err(render_error)?;
-    Ok(())
+        .map(|(label, c)| (*label, c.frequency_hz.as_slice(), c.vibration.as_slice()))
+        .collect();
+    let axis = Axis {
+        caption: "Residual vibration V(f)",
+        x_desc: "frequency (Hz)",
+    };
+    draw_vibration_curves(area, &curves, vtol, modes_hz, &axis, style)
 }

@@ -20,7 +20,7 @@
 //! hold to rounding.
 
 use crate::design::{DesignRequest, Guarantee, ShaperSpec};
-use crate::error::{finite, positive, Error, Result};
+use crate::error::{Error, Result};
 use crate::mode::Mode;
 use crate::shaper::Shaper;
 use crate::solve::{self, Problem, ZeroVibration};
@@ -89,26 +89,7 @@ pub(crate) fn direct(spec: &DirectSpec, modes: &[Mode]) -> Result<(Shaper, Guara
         });
     }
     crate::error::count("modes", modes.len(), 1, MAX_DIRECT_MODES)?;
-    finite("amplitudeMin", spec.amplitude_min)?;
-    finite("amplitudeMax", spec.amplitude_max)?;
-    if spec.amplitude_max <= 0.0 {
-        return Err(Error::invalid(
-            "amplitudeMax",
-            format!("must be > 0, got {}", spec.amplitude_max),
-        ));
-    }
-    if spec.amplitude_min >= spec.amplitude_max || spec.amplitude_min > 1.0 {
-        return Err(Error::invalid(
-            "amplitudeMin",
-            format!(
-                "must be below amplitudeMax ({}) and at most 1, got {}",
-                spec.amplitude_max, spec.amplitude_min
-            ),
-        ));
-    }
-    if let Some(d) = spec.max_duration {
-        positive("maxDuration", d)?;
-    }
+    super::solved::check_bounds(spec.amplitude_min, spec.amplitude_max, spec.max_duration)?;
     let problem = Problem {
         zeros: modes
             .iter()

@@ -16,6 +16,7 @@
 pub mod direct;
 pub mod quantize;
 pub mod sampled;
+mod solved;
 pub mod specified;
 pub mod zero_vibration;
 

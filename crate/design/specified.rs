@@ -190,26 +190,7 @@ fn tolerance(spec: &SiSpec) -> Result<Tolerance> {
 
 /// Checks the amplitude bounds, `maxDuration` and `maxImpulses`.
 fn check_amplitudes_and_limits(spec: &SiSpec) -> Result<()> {
-    finite("amplitudeMin", spec.amplitude_min)?;
-    finite("amplitudeMax", spec.amplitude_max)?;
-    if spec.amplitude_max <= 0.0 {
-        return Err(Error::invalid(
-            "amplitudeMax",
-            format!("must be > 0, got {}", spec.amplitude_max),
-        ));
-    }
-    if spec.amplitude_min >= spec.amplitude_max || spec.amplitude_min > 1.0 {
-        return Err(Error::invalid(
-            "amplitudeMin",
-            format!(
-                "must be below amplitudeMax ({}) and at most 1, got {}",
-                spec.amplitude_max, spec.amplitude_min
-            ),
-        ));
-    }
-    if let Some(d) = spec.max_duration {
-        positive("maxDuration", d)?;
-    }
+    super::solved::check_bounds(spec.amplitude_min, spec.amplitude_max, spec.max_duration)?;
     if let Some(n) = spec.max_impulses {
         crate::error::count("maxImpulses", n, 1, MAX_IMPULSES_PARAMETER)?;
     }

@@ -9,70 +9,10 @@
 
 use std::f64::consts::PI;
 
-/// A complex number `re + i·im` (the crate needs nothing more than this).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Complex {
-    /// Real part.
-    pub re: f64,
-    /// Imaginary part.
-    pub im: f64,
-}
-
-impl Complex {
-    /// `re + i·im`.
-    pub const fn new(re: f64, im: f64) -> Self {
-        Complex { re, im }
-    }
-    /// e^{iθ}.
-    pub fn cis(theta: f64) -> Self {
-        let (s, c) = theta.sin_cos();
-        Complex::new(c, s)
-    }
-    /// |z|².
-    pub fn norm_sqr(self) -> f64 {
-        self.re * self.re + self.im * self.im
-    }
-    /// |z|.
-    pub fn abs(self) -> f64 {
-        self.re.hypot(self.im)
-    }
-    /// The complex conjugate.
-    pub fn conj(self) -> Self {
-        Complex::new(self.re, -self.im)
-    }
-    #[inline]
-    fn mul(self, o: Complex) -> Complex {
-        Complex::new(
-            self.re * o.re - self.im * o.im,
-            self.re * o.im + self.im * o.re,
-        )
-    }
-}
-
-impl std::ops::Add for Complex {
-    type Output = Complex;
-    fn add(self, o: Complex) -> Complex {
-        Complex::new(self.re + o.re, self.im + o.im)
-    }
-}
-impl std::ops::Sub for Complex {
-    type Output = Complex;
-    fn sub(self, o: Complex) -> Complex {
-        Complex::new(self.re - o.re, self.im - o.im)
-    }
-}
-impl std::ops::Mul for Complex {
-    type Output = Complex;
-    fn mul(self, o: Complex) -> Complex {
-        Complex::mul(self, o)
-    }
-}
-impl std::ops::Mul<f64> for Complex {
-    type Output = Complex;
-    fn mul(self, k: f64) -> Complex {
-        Complex::new(self.re * k, self.im * k)
-    }
-}
+/// A complex number `re + i·im`: nalgebra's (num-complex's), the one the rest of the crate
+/// uses too. Its product, conjugate, |z|² and e^{iθ} (`cis`) are the same formulas the plans
+/// need.
+pub type Complex = nalgebra::Complex<f64>;
 
 /// Radix-2 plan: twiddles e^{−2πik/N} for k < N/2 and the bit-reversal permutation.
 #[derive(Debug, Clone)]
@@ -122,7 +62,7 @@ impl Radix2 {
                 for k in 0..half {
                     let t = hi[k] * self.twiddles[k * stride];
                     hi[k] = lo[k] - t;
-                    lo[k] = lo[k] + t;
+                    lo[k] += t;
                 }
             }
             half *= 2;
@@ -163,7 +103,7 @@ impl Bluestein {
         inner.forward(&mut kernel);
         let scale = 1.0 / m as f64;
         for z in &mut kernel {
-            *z = *z * scale;
+            *z *= scale;
         }
         Bluestein {
             n,
@@ -182,7 +122,7 @@ impl Bluestein {
         }
         self.inner.forward(scratch);
         for (z, k) in scratch.iter_mut().zip(&self.kernel) {
-            *z = *z * *k;
+            *z *= *k;
         }
         // Inverse transform as conj(FFT(conj(·))).
         for z in scratch.iter_mut() {
@@ -321,9 +261,9 @@ mod tests {
             let mut y = x.clone();
             Fft::new(n).forward(&mut y);
             let z = naive(&x);
-            let scale = z.iter().map(|c| c.abs()).fold(1.0, f64::max);
+            let scale = z.iter().map(|c| c.norm()).fold(1.0, f64::max);
             for (a, b) in y.iter().zip(&z) {
-                assert!((*a - *b).abs() < 1e-11 * scale, "n = {n}: {a:?} vs {b:?}");
+                assert!((*a - *b).norm() < 1e-11 * scale, "n = {n}: {a:?} vs {b:?}");
             }
         }
     }

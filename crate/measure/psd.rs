@@ -400,7 +400,7 @@ pub fn fft_spectrum(signal: &[f64], options: &FftOptions) -> Result<AmplitudeSpe
             } else {
                 2.0
             };
-            data[k].abs() * f / sum_w
+            data[k].norm() * f / sum_w
         })
         .collect();
     Ok(AmplitudeSpectrum {
