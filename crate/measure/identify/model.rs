@@ -96,7 +96,7 @@ fn kernel(spec: WindowSpec, q: usize) -> Vec<f64> {
             let nu = j as f64 / q as f64;
             let mut acc = Complex::default();
             for (i, &wi) in w.iter().enumerate() {
-                acc = acc + Complex::cis(-2.0 * PI * nu * i as f64 / n as f64) * wi;
+                acc += Complex::cis(-2.0 * PI * nu * i as f64 / n as f64) * wi;
             }
             acc.norm_sqr()
         })
@@ -128,7 +128,7 @@ fn response(x: &[f64], m: usize, power: i32, f_ref: f64, edges: Edges, f: f64) -
         let g = x[3 * i + 2];
         let den = Complex::new(fi * fi - f * f, 2.0 * z * fi * f);
         let num = g * (f / fi).powi(power) * fi * fi / den.norm_sqr();
-        h = h + den.conj() * num;
+        h += den.conj() * num;
     }
     band * (x[3 * m + 1] * (f / f_ref).ln()).exp() * h.norm_sqr()
 }

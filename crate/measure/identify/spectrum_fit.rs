@@ -18,7 +18,7 @@ pub(super) fn modal_psd(params: &[f64], modes: usize, power: i32, f: f64) -> f64
         let den = Complex::new(wn * wn - w * w, 2.0 * z * wn * w);
         let num = g * (w / wn).powi(power) * wn * wn / den.norm_sqr();
         // g·(ω/ωₙ)^p·ωₙ²/den = num·conj(den)
-        h = h + den.conj() * num;
+        h += den.conj() * num;
     }
     h.norm_sqr() + params[3 * modes].exp()
 }
@@ -31,7 +31,7 @@ pub(super) fn kernel(kind: WindowKind, n: usize, q: usize, j_max: usize) -> Vec<
             let j = jj as f64 - j_max as f64;
             let mut acc = Complex::default();
             for (i, &wi) in w.iter().enumerate() {
-                acc = acc + Complex::cis(-2.0 * PI * j * i as f64 / (q * n) as f64) * wi;
+                acc += Complex::cis(-2.0 * PI * j * i as f64 / (q * n) as f64) * wi;
             }
             acc.norm_sqr()
         })
