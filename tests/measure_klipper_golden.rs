@@ -116,14 +116,19 @@ fn compare(key: &str, fit: &KlipperFit, want: &Value) -> f64 {
             } else {
                 rel(ours, theirs)
             };
+            // 1e-8: numpy and this crate sum V·P in different orders (the fit chains its
+            // complex exponentials over the bins); Klipper itself prints 0.1 % and 0.001.
             assert!(
-                d < 1e-9,
+                d < 1e-8,
                 "{key} {}: {what} {ours} vs {theirs} (rel {d:e})",
                 fam.name
             );
             worst = worst.max(d);
         }
         let curve = &w["curve"];
+        if curve.is_null() {
+            continue; // the option variants carry the figures, not the curves
+        }
         let vals: Vec<f64> = serde_json::from_value(curve["vals"].clone()).unwrap();
         assert_eq!(
             fam.vals.len(),
@@ -154,6 +159,23 @@ fn compare(key: &str, fit: &KlipperFit, want: &Value) -> f64 {
     worst
 }
 
+/// The reference's calibrate_shaper.py options as [`FitOptions`] (null = Klipper's default).
+fn fit_options(opts: &Value) -> FitOptions {
+    let list = |v: &Value| -> Option<Vec<Value>> { v.as_array().cloned() };
+    FitOptions {
+        shapers: list(&opts["shapers"])
+            .map(|v| v.iter().map(|s| s.as_str().unwrap().to_string()).collect()),
+        damping_ratio: opts["damping_ratio"].as_f64(),
+        scv: opts["scv"].as_f64().unwrap_or(5.0),
+        max_smoothing: opts["max_smoothing"].as_f64(),
+        max_vibrations: opts["max_vibrs_pcnt"].as_f64().map(|p| p / 100.0),
+        test_damping_ratios: list(&opts["test_damping_ratios"])
+            .map(|v| v.iter().map(|x| x.as_f64().unwrap()).collect()),
+        max_freq: opts["max_freq"].as_f64(),
+        ..FitOptions::default()
+    }
+}
+
 #[test]
 fn every_file_of_the_test_set_gives_the_reference_fit() {
     let text = std::fs::read_to_string(Path::new(DIR).join("expected.json")).unwrap();
@@ -164,14 +186,20 @@ fn every_file_of_the_test_set_gives_the_reference_fit() {
         expected.len()
     );
     let mut worst = 0.0_f64;
+    let mut variants = 0;
     for (key, want) in &expected {
         let opts = &want["options"];
-        // The reference ran calibrate_shaper.py's defaults; fail loudly if that changes.
-        assert!(
-            opts["max_smoothing"].is_null() && opts["max_freq"].is_null(),
-            "{key}"
-        );
-        assert_eq!(opts["scv"].as_f64(), Some(5.0), "{key}");
+        // Klipper's 2021-2023 EI definitions and selection rules (the reference's `--defs
+        // classic` / `--legacy`) are not reproduced here: the crate follows current mainline.
+        if opts["defs"].as_str().is_some_and(|d| d != "current")
+            || opts["legacy_selection"].as_bool() == Some(true)
+        {
+            continue;
+        }
+        let options = fit_options(opts);
+        if key.contains('|') {
+            variants += 1;
+        }
         let files: Vec<&str> = want["files"]
             .as_array()
             .unwrap()
@@ -190,8 +218,10 @@ fn every_file_of_the_test_set_gives_the_reference_fit() {
                 Some(c) => c.add_data(d).unwrap(),
             }
         }
-        let fit = find_best_shaper(&data.unwrap(), &FitOptions::default()).unwrap();
+        let fit = find_best_shaper(&data.unwrap(), &options).unwrap();
         worst = worst.max(compare(key, &fit, want));
     }
+    // The option variants (max_smoothing, max_vibrs_pcnt, scv, shapers, damping) were compared.
+    assert!(variants >= 5, "only {variants} option variants compared");
     println!("worst relative difference over the test set: {worst:e}");
 }
