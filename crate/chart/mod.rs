@@ -4,6 +4,7 @@
 pub mod command;
 pub mod damping;
 pub mod impulses;
+pub mod klipper;
 pub mod map;
 pub mod measured;
 pub mod response;
@@ -17,6 +18,7 @@ use plotters::prelude::*;
 pub use command::draw_command;
 pub use damping::draw_damping_sensitivity;
 pub use impulses::draw_impulses;
+pub use klipper::{draw_klipper_chart, KlipperChart, ShaperCurve};
 pub use map::{draw_sensitivity_map, draw_sensitivity_map_with, MapCells};
 pub use measured::draw_measured_spectrum;
 pub use response::draw_response;
