@@ -197,8 +197,9 @@ impl JsRecordingParser {
 /// symmetricWindow?, detrend?, scaling? })` → `{ frequencyHz, psd (Float64Array),
 /// segmentLength, overlap, segments, resolutionHz, enbwBins, sampleRateHz }`; `signal` is a
 /// `Float64Array` or an array of numbers. `{ preset: 'klipper', sampleRateHz }` takes
-/// Klipper's settings instead.
-#[cfg(feature = "js-api")]
+/// Klipper's settings instead. (In the recording module too: the page's measured-data worker
+/// forms Klipper's spectra of raw recordings with it.)
+#[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = welch)]
 pub fn welch_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     let x = f64_vec(&signal, "signal").map_err(js_error)?;

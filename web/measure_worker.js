@@ -1,32 +1,43 @@
-// The measured-data worker: reads a recording in chunks, identifies the modes and ranks the
+// The measured-data worker: reads recordings in chunks, identifies the modes and ranks the
 // shapers off the page's thread, so a 10⁶-row file never freezes the page. Messages in:
-// { type: 'module', module } (first: the page's compiled wasm module), { id, type: 'load', file,
+// { type: 'module', module, recordingModule } (first: the page's compiled wasm module and the
+// recording module, compiled by the page's measured-data view), { id, type: 'load', files,
 // options }, { id, type: 'analyse', options } and { id, type: 'fft', channel }; out: progress,
-// result ({ recording, identification, recommendation, rankingError }), fft ({ spectrum }) or
-// error ({ message, line, column }). Reading and identifying use the worker's own small module
-// (pkg/page/recording.js); the ranking designs every candidate shaper, which only the page's
-// module can, so the page hands over that module, already compiled (nothing fetched again).
-import initRecording, { RecordingParser, identifyModes, fftSpectrum } from '../pkg/page/recording.js';
+// result ({ recording, identification, recommendation, rankingError, axes }), fft
+// ({ spectrum }) or error ({ message, file, line, column }). Reading and identifying use the
+// worker's own small module (pkg/page/recording.js); the ranking designs every candidate
+// shaper, which only the page's module can, so the page hands over that module, already
+// compiled (nothing fetched again).
+//
+// `axes`: one entry per machine axis (from the file names: Klipper writes
+// raw_data_<axis>_…, resonances_<axis>_…, calibration_data_<axis>_…), each with Klipper's
+// spectrum (PSD of x, y, z and their sum; several files of one axis combined as
+// calibrate_shaper.py combines them), Klipper's table (recommendShaper, criterion 'klipper'),
+// the optimised rows where the page's module has them, and the shaper curves a calibration
+// file carries.
+import initRecording, { RecordingParser, identifyModes, fftSpectrum, welch } from '../pkg/page/recording.js';
 import initPlayground, { recommendShaper } from '../pkg/page/playground.js';
 
 const CHUNK_BYTES = 1 << 20;
-const ready = initRecording();
+let ready = null; // the recording module, instantiated here
 let designs = null; // the page's module, instantiated here
-let recording = null; // the last good recording
+let recording = null; // the last good raw recording (modes, FFT)
+let loaded = null; // the last good files, parsed: [{ name, rec }]
 
 function summary(r) {
   const { channels, ...rest } = r;
-  return { ...rest, channels: channels.map((c) => c.name) };
+  return { ...rest, channels: (channels ?? []).map((c) => c.name) };
 }
 
-async function read(id, file) {
+async function read(id, file, done, total) {
   const parser = new RecordingParser({});
   const decoder = new TextDecoder('utf-8');
   try {
     for (let offset = 0; offset < file.size; offset += CHUNK_BYTES) {
       const bytes = await file.slice(offset, offset + CHUNK_BYTES).arrayBuffer();
       parser.push(decoder.decode(bytes, { stream: true }));
-      postMessage({ id, type: 'progress', fraction: Math.min(1, (offset + bytes.byteLength) / Math.max(1, file.size)), rows: parser.rows });
+      const fraction = (done + offset + bytes.byteLength) / Math.max(1, total);
+      postMessage({ id, type: 'progress', fraction: Math.min(1, fraction), rows: parser.rows, file: file.name });
     }
     parser.push(decoder.decode());
     return parser.finish();
@@ -35,8 +46,187 @@ async function read(id, file) {
   }
 }
 
-function analyse(id, rec, options) {
-  postMessage({ id, type: 'analysing', rows: rec.rows });
+// ---- Klipper's spectra ---------------------------------------------------------------------
+
+/** The machine axis a Klipper file is for, from its name (`resonances_x_…`), or null. */
+function axisOf(name, rec) {
+  const m = /(?:^|[\\/])(?:raw_data|resonances|calibration_data)_([a-z0-9]+?)_/i.exec(name)
+    ?? /(?:^|[_\-. ])([xyz])(?:[_\-. ]|$)/i.exec(name.replace(/\.[^.]*$/, ''));
+  return (m?.[1] ?? rec?.axis ?? rec?.spectrum?.axis ?? null)?.toLowerCase() ?? null;
+}
+
+/** Whether a parsed file is a spectrum (resonances or calibration data) rather than samples. */
+function spectrumOf(rec) {
+  const s = rec.spectrum ?? (rec.psdSum || rec.psd_xyz ? rec : null);
+  if (!s) return null;
+  const f = s.frequencyHz ?? s.freq;
+  const sum = s.psdSum ?? s.psd_xyz ?? s.psd;
+  return f && sum ? { s, f, sum } : null;
+}
+
+/**
+ * Klipper's `normalize_to_frequencies` (klippy/extras/shaper_calibrate.py, CalibrationData):
+ * each PSD divided by (f + 0.1) and zeroed below 5 Hz, as calibrate_shaper.py does to raw data
+ * and to resonances files (whose header has no shaper columns) after reading them.
+ */
+function normalize(psd, f) {
+  return Float64Array.from(psd, (p, i) => (f[i] < 5 ? 0 : p / (f[i] + 0.1)));
+}
+
+/** Klipper's spectrum of one parsed file: { frequencyHz, psdX, psdY, psdZ, psdSum, fitted }. */
+function klipperSpectrum(name, rec) {
+  const spec = spectrumOf(rec);
+  if (spec) {
+    const { s, f } = spec;
+    // Calibration files hold Klipper's normalised PSD; resonances files the raw one, which
+    // calibrate_shaper.py normalises when it reads them (parse_log).
+    const kind = `${rec.format ?? ''} ${s.kind ?? ''}`;
+    const done = /calibration/i.test(kind) || s.normalized === true
+      || (typeof s.normalization === 'string' && !/^(none|raw)$/i.test(s.normalization));
+    const norm = (p) => (p ? (done ? Float64Array.from(p) : normalize(p, f)) : null);
+    const fitted = (rec.shapers ?? s.shapers ?? []).map((c) => ({
+      name: c.name ?? c.family, freq: c.frequencyHz ?? c.freq, values: c.values ?? c.vals,
+    })).filter((c) => c.values?.length === f.length);
+    return {
+      frequencyHz: Float64Array.from(f), psdX: norm(s.psdX), psdY: norm(s.psdY), psdZ: norm(s.psdZ),
+      psdSum: norm(spec.sum), fitted, kind: /calibration/i.test(kind) ? 'calibration' : 'resonances',
+    };
+  }
+  // Raw samples: Klipper's process_accelerometer_data — Welch with its settings per axis, the
+  // sum of the three, then normalize_to_frequencies (calibrate_shaper.py, calibrate_shaper).
+  const channels = rec.channels ?? [];
+  const pick = (axis) => channels.find((c) => new RegExp(`(^|_)${axis}$`, 'i').test(c.name));
+  const xyz = ['x', 'y', 'z'].map(pick);
+  const used = xyz.some(Boolean) ? xyz : [channels[0], null, null];
+  // Klipper's sampling rate: N / (t_last − t_first).
+  const fs = rec.rows > 1 && rec.durationS > 0 ? rec.rows / rec.durationS : rec.sampleRateHz;
+  const psds = used.map((c) => (c ? welch(c.values, { preset: 'klipper', sampleRateHz: fs }) : null));
+  const f = psds.find(Boolean).frequencyHz;
+  const sum = new Float64Array(f.length);
+  for (const p of psds) if (p) p.psd.forEach((v, i) => { sum[i] += v; });
+  const [px, py, pz] = psds.map((p) => (p ? normalize(p.psd, f) : null));
+  return { frequencyHz: f, psdX: px, psdY: py, psdZ: pz, psdSum: normalize(sum, f), fitted: [], kind: 'raw' };
+}
+
+/**
+ * Several runs of one axis combined as calibrate_shaper.py combines them
+ * (CalibrationData.add_data): each PSD interpolated onto the first file's bins, then the mean
+ * over the files.
+ */
+function combine(spectra) {
+  if (spectra.length === 1) return spectra[0];
+  const [first] = spectra;
+  const f = first.frequencyHz;
+  const interp = (fx, p) => Float64Array.from(f, (x) => {
+    let j = 1;
+    while (j < fx.length - 1 && fx[j] < x) j++;
+    const t = Math.min(1, Math.max(0, (x - fx[j - 1]) / (fx[j] - fx[j - 1] || 1)));
+    return p[j - 1] + t * (p[j] - p[j - 1]);
+  });
+  const out = { ...first, fitted: spectra.flatMap((s) => s.fitted), kind: first.kind };
+  for (const key of ['psdX', 'psdY', 'psdZ', 'psdSum']) {
+    if (spectra.some((s) => !s[key])) { out[key] = key === 'psdSum' ? first.psdSum : null; continue; }
+    const mean = new Float64Array(f.length);
+    for (const s of spectra) {
+      const p = s.frequencyHz === f ? s[key] : interp(s.frequencyHz, s[key]);
+      p.forEach((v, i) => { mean[i] += v / spectra.length; });
+    }
+    out[key] = mean;
+  }
+  return out;
+}
+
+/**
+ * V(f) of an impulse sequence as Klipper's figure draws it: the largest over its test damping
+ * ratios 0.075, 0.1, 0.15 of |Σ Aᵢ e^{−ζω(T−tᵢ)} e^{iω_d tᵢ}| / Σ Aᵢ (shaper_calibrate.py,
+ * `_estimate_shaper` and `_estimate_remaining_vibrations`). Used only when the ranking does not
+ * give the curve itself.
+ */
+function shaperCurve(impulses, f) {
+  const sumA = impulses.reduce((s, p) => s + p.amplitude, 0);
+  const end = impulses[impulses.length - 1].time;
+  return Float64Array.from(f, (x) => {
+    let worst = 0;
+    for (const z of [0.075, 0.1, 0.15]) {
+      const w = 2 * Math.PI * x;
+      const wd = w * Math.sqrt(1 - z * z);
+      let s = 0;
+      let c = 0;
+      for (const p of impulses) {
+        const a = p.amplitude * Math.exp(-z * w * (end - p.time));
+        s += a * Math.sin(wd * p.time);
+        c += a * Math.cos(wd * p.time);
+      }
+      worst = Math.max(worst, Math.hypot(s, c) / sumA);
+    }
+    return worst;
+  });
+}
+
+/** One row of Klipper's table from a ranked candidate. */
+function row(c, f) {
+  const values = c.values ?? c.vals ?? (c.shaper?.impulses ? shaperCurve(c.shaper.impulses, f) : null);
+  return {
+    label: c.label ?? c.name ?? c.family,
+    name: c.name ?? c.family,
+    freq: c.frequencyHz ?? c.freq ?? c.spec?.frequencyHz ?? c.modes?.[0]?.frequencyHz ?? NaN,
+    damping: c.dampingRatio ?? c.damping ?? c.spec?.damping ?? c.modes?.[0]?.damping ?? NaN,
+    vibrations: c.vibrations ?? c.vibrs ?? c.remainingVibration,
+    smoothing: c.smoothing,
+    maxAccel: c.maxAccel,
+    score: c.score ?? c.klipperScore,
+    values: values ? Float64Array.from(values) : null,
+    shaper: c.shaper ?? null,
+  };
+}
+
+const CHANNEL_KEY = { sum: 'psdSum', x: 'psdX', y: 'psdY', z: 'psdZ' };
+
+/** Klipper's table (and the optimised rows, where available) for one axis. */
+function rankAxis(axis, spectrum, modes, channel) {
+  const f = spectrum.frequencyHz;
+  const psd = spectrum[CHANNEL_KEY[channel]] ?? spectrum.psdSum;
+  const input = { ...spectrum, psd, channel };
+  // Until the ranking reads a spectrum alone, the candidates are designed at the highest peak
+  // of the spectrum (Klipper's damping ratio 0.1) when no mode was identified.
+  let peak = 0;
+  psd.forEach((p, i) => { if (f[i] <= 200 && p > psd[peak]) peak = i; });
+  const at = modes?.length ? modes : [{ frequencyHz: f[peak], damping: 0.1 }];
+  const out = { axis, spectrum, channel, klipper: null, optimal: null, error: null };
+  try {
+    const rec = recommendShaper(input, at, { criterion: 'klipper' });
+    out.klipper = { rows: rec.ranked.map((c) => row(c, f)), selected: rec.recommended };
+  } catch (e) {
+    out.error = e?.message ?? String(e);
+  }
+  try {
+    const opt = recommendShaper(input, at, { criterion: 'optimal', firmware: 'klipper' });
+    const rows = opt.rows ?? opt.table ?? opt.ranked;
+    if (rows?.length) out.optimal = { rows: rows.map((c) => row(c, f)), selected: opt.recommended ?? 0 };
+  } catch {
+    // 'optimal' is not in this module's ranking (yet): the table shows Klipper's rows only.
+  }
+  return out;
+}
+
+/** Files grouped per axis; each group's spectrum, ranked. */
+function klipperAxes(files, options, modes, modesFile) {
+  const groups = new Map();
+  for (const { name, rec } of files) {
+    const axis = axisOf(name, rec) ?? name;
+    if (!groups.has(axis)) groups.set(axis, []);
+    groups.get(axis).push({ name, rec });
+  }
+  return [...groups].map(([axis, list]) => {
+    const spectrum = combine(list.map(({ name, rec }) => klipperSpectrum(name, rec)));
+    const ranked = rankAxis(axis, spectrum, list.some(({ name }) => name === modesFile) ? modes : null, options.psdChannel ?? 'sum');
+    return { ...ranked, files: list.map((x) => x.name), formats: list.map((x) => x.rec.format) };
+  });
+}
+
+// ---- modes of the first raw recording (as before) ------------------------------------------
+
+function identify(rec, options) {
   const identification = identifyModes(rec, options);
   let recommendation = null;
   let rankingError = null;
@@ -47,25 +237,58 @@ function analyse(id, rec, options) {
       rankingError = e?.message ?? String(e); // the modes stay shown; only the ranking is missing
     }
   }
-  return { id, type: 'result', recording: summary(rec), identification, recommendation, rankingError };
+  return { identification, recommendation, rankingError };
+}
+
+function analyse(id, files, options) {
+  const raw = files.find(({ rec }) => rec.channels && rec.sampleRateHz);
+  let primary = null;
+  let identificationError = null;
+  const first = raw ?? files[0];
+  if (first) {
+    postMessage({ id, type: 'analysing', rows: first.rec.rows ?? 0 });
+    try {
+      primary = identify(first.rec, options.identify);
+    } catch (e) {
+      if (raw) throw e;
+      identificationError = e?.message ?? String(e); // a spectrum the identification cannot read yet
+    }
+  }
+  const axes = klipperAxes(files, options, primary?.identification?.modes, first?.name);
+  return {
+    id, type: 'result', recording: first ? summary(first.rec) : null, file: first?.name, raw: Boolean(raw),
+    ...(primary ?? { identification: null, recommendation: null, rankingError: null }), identificationError, axes,
+  };
 }
 
 onmessage = async ({ data }) => {
   const { id } = data;
   if (data.type === 'module') {
+    ready = initRecording(data.recordingModule ? { module_or_path: data.recordingModule } : undefined);
     designs = initPlayground(data.module ? { module_or_path: data.module } : undefined);
     return;
   }
+  let file = null;
   try {
-    await ready;
+    await (ready ??= initRecording());
     await (designs ??= initPlayground()); // without the page's module, fetch it
     if (data.type === 'load') {
-      const rec = await read(id, data.file);
-      const result = analyse(id, rec, data.options);
-      recording = rec; // only once everything worked: a bad file leaves the last good one
+      const list = [];
+      const total = data.files.reduce((s, x) => s + x.size, 0);
+      let done = 0;
+      for (const f of data.files) {
+        file = f.name;
+        list.push({ name: f.name, rec: await read(id, f, done, total) });
+        done += f.size;
+      }
+      file = null;
+      const result = analyse(id, list, data.options);
+      // Only once everything worked: a bad file leaves the last good result.
+      loaded = list;
+      recording = list.find(({ rec }) => rec.channels && rec.sampleRateHz)?.rec ?? null;
       postMessage(result);
-    } else if (data.type === 'analyse' && recording) {
-      postMessage(analyse(id, recording, data.options));
+    } else if (data.type === 'analyse' && loaded) {
+      postMessage(analyse(id, loaded, data.options));
     } else if (data.type === 'fft' && recording) {
       // The plain FFT magnitude of the whole channel (at most 2^22 samples), as |X|² for the chart.
       const values = recording.channels[data.channel]?.values ?? recording.channels[0].values;
@@ -74,6 +297,6 @@ onmessage = async ({ data }) => {
       postMessage({ id, type: 'fft', spectrum: { frequencyHz: s.frequencyHz, psd: power } }, [power.buffer]);
     }
   } catch (e) {
-    postMessage({ id, type: 'error', message: e?.message ?? String(e), line: e?.line, column: e?.column });
+    postMessage({ id, type: 'error', file, message: e?.message ?? String(e), line: e?.line, column: e?.column });
   }
 };
