@@ -575,6 +575,7 @@ fn generic_csv_with_named_time_column_and_milliseconds() {
         &RecordingOptions {
             time_column: Some("stamp (ms)".into()),
             time_scale: 1e-3,
+            ..RecordingOptions::default()
         },
     )
     .unwrap();

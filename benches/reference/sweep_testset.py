@@ -305,37 +305,65 @@ FULL = exc(5.0, 200.0)  # Klipper's default test: 195 s
 
 def cases():
     c = []
-    # --- raw recordings (short, Klipper's raw CSV), each also as resonances + calibration ---
-    c.append(dict(name="single47z08", axis="x", rate=3200.0, seed=101, noise=60.0,
+    # --- short raw recordings (Klipper's raw CSV), each also as resonances (+ calibration) ---
+    c.append(dict(name="single47z08", axis="x", rate=3200.0, seed=101, noise=150.0,
                   modes=[mode(47.3, 0.08, 14.0)], excitation=exc(38.0, 56.0, hps=2.0),
                   outputs=["raw", "resonances", "calibration_data"],
                   note="one mode; band 38-56 Hz at Klipper's fastest 2 Hz/s"))
-    c.append(dict(name="two38x14", axis="y", rate=3200.0, seed=102, noise=60.0,
+    c.append(dict(name="two38x14", axis="y", rate=3200.0, seed=102, noise=150.0,
                   modes=[mode(38.0, 0.04, 16.0), mode(53.2, 0.04, 12.0)],
                   excitation=exc(33.0, 58.0, hps=2.0),
                   outputs=["raw", "resonances", "calibration_data"],
                   note="two modes, ratio 1.4, the second 4 dB weaker (peak_db 16 vs 12)"))
-    c.append(dict(name="slow3modes", axis="x", rate=1000.0, seed=103, noise=40.0,
+    c.append(dict(name="z018f61", axis="x", rate=3200.0, seed=104, noise=150.0,
+                  modes=[mode(61.0, 0.18, 9.0)], excitation=exc(40.0, 90.0, hps=5.0),
+                  outputs=["raw", "resonances"],
+                  note="a heavily damped mode; 5 Hz/s (faster than Klipper's HZ_PER_SEC "
+                       "maximum of 2) to keep the file small"))
+    c.append(dict(name="slow3modes", axis="x", rate=1000.0, seed=103, noise=100.0,
                   modes=[mode(1.0, 0.05, 14.0), mode(3.4, 0.04, 12.0), mode(11.0, 0.03, 10.0)],
                   excitation=exc(0.5, 16.0, aph=300.0, hps=0.775, sacc=400.0, sper=0.0),
                   outputs=["raw", "resonances"],
                   note="slow machine: 20 s at 1 kHz; sweep 0.5-16 Hz (below Klipper's FREQ_START "
                        "minimum of 1 Hz), no slow sweep; Klipper's Welch bins are 1.95 Hz wide"))
-    # --- full default Klipper tests, PSD files only ---
-    for name, axis, seed, modes in [
-        ("z001f88", "x", 201, [mode(88.0, 0.01, 12.0)]),
-        ("z003f23", "y", 202, [mode(23.0, 0.03, 14.0)]),
-        ("z008f47", "x", 203, [mode(47.3, 0.08, 14.0)]),
-        ("z020f61", "y", 204, [mode(61.0, 0.2, 8.0)]),
+    # --- Klipper's default test (5-200 Hz at 1 Hz/s, 195 s): PSD files only ---
+    full = "Klipper's default test 5-200 Hz at 1 Hz/s with the slow sweep"
+    for name, axis, seed, modes, outs, note in [
+        ("z001f88", "x", 201, [mode(88.0, 0.01, 12.0)], ["resonances"], "single mode"),
+        ("z003f23", "y", 202, [mode(23.0, 0.03, 14.0)], ["resonances"], "single mode"),
+        ("z008f47", "x", 203, [mode(47.3, 0.08, 14.0)], ["resonances"], "single mode"),
+        ("z020f61", "y", 204, [mode(61.0, 0.2, 8.0)], ["resonances"], "single mode"),
+        ("z003f110", "x", 205, [mode(110.0, 0.03, 12.0)], ["resonances"], "single mode"),
+        ("two45x14", "x", 206, [mode(45.0, 0.05, 14.0), mode(63.0, 0.05, 10.0)],
+         ["resonances", "calibration_data"],
+         "two modes, ratio 1.4, the second 4 dB weaker"),
+        ("three", "y", 207, [mode(32.0, 0.06, 12.0), mode(51.0, 0.03, 14.0),
+                             mode(87.0, 0.1, 10.0)],
+         ["resonances", "calibration_data"], "three modes"),
+        # one machine: its X and Y axes (SHAPER_CALIBRATE without AXIS writes both, NAME m1),
+        # and a second run of X with other noise (and drift) for robustness tests
+        ("m1", "x", 301, [mode(42.0, 0.06, 14.0), mode(71.0, 0.04, 9.0)],
+         ["resonances", "calibration_data"], "machine m1, X axis"),
+        ("m1", "y", 302, [mode(36.0, 0.07, 14.0), mode(63.0, 0.05, 10.0)],
+         ["resonances", "calibration_data"], "machine m1, Y axis"),
+        ("m1run2", "x", 303, [mode(42.0, 0.06, 14.0), mode(71.0, 0.04, 9.0)],
+         ["resonances"], "machine m1, X axis, second run: other noise seed"),
     ]:
-        c.append(dict(name=name, axis=axis, rate=3200.0, seed=seed, noise=60.0, modes=modes,
-                      excitation=FULL, outputs=["resonances"],
-                      note="single mode, Klipper's default test 5-200 Hz at 1 Hz/s"))
+        c.append(dict(name=name, axis=axis, rate=3200.0, seed=seed, noise=150.0, modes=modes,
+                      excitation=FULL, outputs=outs, note=note + "; " + full))
+    c[-1]["drift"] = {"offset": -40.0, "slope": -2.0, "sine": 35.0, "period": 55.0}
+    c.append(dict(name="noisy47", axis="y", rate=3200.0, seed=208, noise=400.0,
+                  modes=[mode(47.3, 0.08, 14.0)], excitation=FULL, outputs=["resonances"],
+                  note="single mode, noise 400 mm/s^2 (PSD floor ~100); " + full))
     return c
 
 
+def case_key(case):
+    return "%s_%s" % (case["axis"], case["name"])
+
+
 # expected.json keys for several files read together -> the cases whose resonances files
-COMBINED = {}
+COMBINED = {"resonances_x_m1+resonances_x_m1run2": ["x_m1", "x_m1run2"]}
 
 
 def main(argv=None):
@@ -354,14 +382,15 @@ def main(argv=None):
     if (only or a.expected_only) and os.path.exists(manifest_path):
         manifest = json.load(open(manifest_path))["cases"]
     for case in cases():
-        if a.expected_only or (only and case["name"] not in only):
+        if a.expected_only or (only and case["name"] not in only
+                                         and case_key(case) not in only):
             continue
         print("generating", case["name"], file=sys.stderr)
         files = write_files(case, a.out)
         entry = {k: v for k, v in case.items() if not k.startswith("_") and k != "outputs"}
         entry.update(duration_s=case["_duration"], samples=case["_samples"],
                      clipped_samples=case["_clipped"], files=files)
-        manifest[case["name"]] = entry
+        manifest[case_key(case)] = entry
     doc = {
         "generator": "benches/reference/sweep_testset.py",
         "model": "base-excited modes: e_i'' + 2 zeta_i w_i e_i' + w_i^2 e_i = -a_cmd; "

@@ -4,7 +4,7 @@
 //!   column), uneven time stamps resampled, read in chunks.
 //! - [`fft`]: the discrete Fourier transform (radix-2 and Bluestein, any length).
 //! - [`psd`]: Welch's power spectral density and the plain FFT amplitude spectrum.
-//! - [`identify`](mod@identify): peaks → frequency and damping ratio by half-power bandwidth, a fit of the
+//! - [`identify`](mod@identify) (split by stage: `peaks`, `half_power`, `spectrum_fit`, `decay`): peaks → frequency and damping ratio by half-power bandwidth, a fit of the
 //!   modal spectrum, and a least-squares fit of the free decay, each with an uncertainty.
 //! - [`recommend`]: the shaper families scored over the measured spectrum (Klipper's
 //!   remaining-vibration, smoothing and max-accel definitions) against their duration.
@@ -15,6 +15,7 @@ pub mod identify;
 pub mod psd;
 pub mod recommend;
 pub mod recording;
+pub mod spectrum_file;
 
 pub use identify::{identify, Identification, IdentifiedMode, IdentifyOptions, SignalKind};
 pub use psd::{fft_spectrum, welch, FftOptions, Psd, WelchOptions, WindowKind};

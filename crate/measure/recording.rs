@@ -20,6 +20,9 @@
 //! piece by piece and show progress. Every error names the line (1-based) and, where it
 //! applies, the column (1-based, with its header name).
 
+use super::spectrum_file::{
+    axis_from_file_name, resolution, FittedShaper, Normalization, SpectrumChannel, SpectrumFile,
+};
 use crate::error::Error;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -46,7 +49,7 @@ pub const TIME_NAMES: &[&str] = &[
     "s",
 ];
 
-/// Options of the parser (JS: `{ timeColumn, timeScale }`).
+/// Options of the parser (JS: `{ timeColumn, timeScale, fileName, channel }`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase", default)]
 pub struct RecordingOptions {
@@ -54,6 +57,10 @@ pub struct RecordingOptions {
     pub time_column: Option<String>,
     /// Factor turning the time column into seconds (default 1; 0.001 for milliseconds).
     pub time_scale: f64,
+    /// The file's name: errors name it, and a Klipper spectrum's axis is read from it.
+    pub file_name: Option<String>,
+    /// For spectrum files, the channel `psd` holds (default `sum`, Klipper's `psd_xyz`).
+    pub channel: SpectrumChannel,
 }
 
 impl Default for RecordingOptions {
@@ -61,6 +68,8 @@ impl Default for RecordingOptions {
         RecordingOptions {
             time_column: None,
             time_scale: 1.0,
+            file_name: None,
+            channel: SpectrumChannel::Sum,
         }
     }
 }
@@ -73,6 +82,11 @@ pub enum RecordingFormat {
     Klipper,
     /// Any other CSV with a time column.
     Csv,
+    /// Klipper's `resonances_<axis>_<name>.csv` (`freq,psd_x,psd_y,psd_z,psd_xyz`).
+    KlipperResonances,
+    /// Klipper's `calibration_data_<axis>_<name>.csv` (the PSDs, then `shapers:` and one
+    /// column per fitted shaper).
+    KlipperCalibration,
 }
 
 /// One signal column.
@@ -152,6 +166,8 @@ pub struct RecordingError {
     pub reason: String,
     /// Too-large errors (rows, columns, line length) are reported as [`Error::TooLarge`].
     pub too_large: Option<(f64, f64)>,
+    /// The file's name, when the options gave it.
+    pub file: Option<String>,
 }
 
 impl RecordingError {
@@ -162,6 +178,7 @@ impl RecordingError {
             column_name: None,
             reason: reason.into(),
             too_large: None,
+            file: None,
         }
     }
     fn field(line: usize, column: usize, name: &str, reason: impl Into<String>) -> Self {
@@ -171,15 +188,23 @@ impl RecordingError {
             column_name: Some(name.to_string()),
             reason: reason.into(),
             too_large: None,
+            file: None,
         }
     }
-    /// "line 12, column 3 (`accel_y`)" — where the error is.
+    /// "`resonances_x.csv`, line 12, column 3 (`psd_y`)" — where the error is.
     pub fn location(&self) -> String {
-        let mut s = if self.line > 0 {
-            format!("line {}", self.line)
-        } else {
-            "recording".to_string()
+        let mut s = match &self.file {
+            Some(f) => format!("`{f}`, "),
+            None => String::new(),
         };
+        if self.line > 0 {
+            s.push_str(&format!("line {}", self.line));
+        } else if self.file.is_some() {
+            s.pop();
+            s.pop();
+        } else {
+            s.push_str("recording");
+        }
         if let Some(c) = self.column {
             s.push_str(&format!(", column {c}"));
             if let Some(n) = &self.column_name {
@@ -224,6 +249,27 @@ struct Header {
     time: usize,
     separator: Separator,
     klipper: bool,
+    spectrum: Option<SpectrumLayout>,
+}
+
+/// Where the columns of a Klipper spectrum file are.
+#[derive(Debug, Clone)]
+struct SpectrumLayout {
+    /// Index of the `shapers:` column.
+    marker: Option<usize>,
+    /// Columns between `psd_xyz` and the marker (or the end).
+    extra: Vec<usize>,
+    /// The shapers' (column, name, frequency).
+    shapers: Vec<(usize, String, f64)>,
+}
+
+/// What a file held: a recording or a spectrum.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Parsed {
+    /// A time series.
+    Recording(Recording),
+    /// A Klipper spectrum file.
+    Spectrum(SpectrumFile),
 }
 
 /// An incremental CSV reader: [`push`](RecordingParser::push) text in chunks of any size
@@ -284,11 +330,18 @@ impl RecordingParser {
         if let Some(e) = &self.failed {
             return Err(e.clone());
         }
-        let result = self.push_inner(chunk);
+        let result = self.push_inner(chunk).map_err(|e| self.located(e));
         if let Err(e) = &result {
             self.failed = Some(e.clone());
         }
         result
+    }
+
+    fn located(&self, mut e: RecordingError) -> RecordingError {
+        if e.file.is_none() {
+            e.file = self.options.file_name.clone();
+        }
+        e
     }
 
     fn push_inner(&mut self, chunk: &str) -> Result<(), RecordingError> {
@@ -365,8 +418,20 @@ impl RecordingParser {
             return Err(e);
         }
         let mut signal = 0;
+        let marker = header.spectrum.as_ref().and_then(|s| s.marker);
         for (j, field) in fields.iter().take(count).enumerate() {
             let name = &header.names[j];
+            if Some(j) == marker {
+                if !field.is_empty() {
+                    return Err(RecordingError::field(
+                        n,
+                        j + 1,
+                        name,
+                        format!("the `shapers:` column should be empty, got `{field}`"),
+                    ));
+                }
+                continue;
+            }
             if field.is_empty() {
                 return Err(RecordingError::field(n, j + 1, name, "the value is empty"));
             }
@@ -380,6 +445,33 @@ impl RecordingParser {
                     name,
                     format!("`{field}` is not a finite number"),
                 ));
+            }
+            if header.spectrum.is_some() {
+                if j == 0 {
+                    if let Some(&prev) = self.times.last() {
+                        if value <= prev {
+                            return Err(RecordingError::field(
+                                n,
+                                1,
+                                name,
+                                format!("frequency {field} does not increase (the previous row has {prev})"),
+                            ));
+                        }
+                    }
+                    self.times.push(value);
+                } else {
+                    if (1..=4).contains(&j) && value < 0.0 {
+                        return Err(RecordingError::field(
+                            n,
+                            j + 1,
+                            name,
+                            format!("a PSD cannot be negative, got {field}"),
+                        ));
+                    }
+                    self.columns[signal].push(value);
+                    signal += 1;
+                }
+                continue;
             }
             if j == header.time {
                 let t = value * self.options.time_scale;
@@ -427,6 +519,24 @@ impl RecordingParser {
             .into_iter()
             .map(|s| s.trim_matches('"').to_string())
             .collect();
+        if names.len() >= 5
+            && names[..5]
+                .iter()
+                .zip(["freq", "psd_x", "psd_y", "psd_z", "psd_xyz"])
+                .all(|(a, b)| a == b)
+        {
+            return self.spectrum_header(names, separator);
+        }
+        if names.first().map(|s| s.as_str()) == Some("freq") {
+            return Err(RecordingError::at(
+                n,
+                format!(
+                    "a spectrum with the columns `{}` is not read: Klipper's spectrum files start \
+                     `freq,psd_x,psd_y,psd_z,psd_xyz`",
+                    names.join(",")
+                ),
+            ));
+        }
         let wanted = self.options.time_column.as_deref();
         let time = names.iter().position(|s| is_time_name(s, wanted));
         let Some(time) = time else {
@@ -493,13 +603,102 @@ impl RecordingParser {
             time,
             separator,
             klipper,
+            spectrum: None,
         });
         self.header_line_seen = n;
         Ok(())
     }
 
-    /// Reads whatever is left, checks the recording and puts it on an even grid.
-    pub fn finish(mut self) -> Result<Recording, RecordingError> {
+    fn spectrum_header(
+        &mut self,
+        names: Vec<String>,
+        separator: Separator,
+    ) -> Result<(), RecordingError> {
+        let n = self.line;
+        if names.len() > MAX_COLUMNS {
+            let mut e = RecordingError::at(n, format!("more than {MAX_COLUMNS} columns"));
+            e.too_large = Some((names.len() as f64, MAX_COLUMNS as f64));
+            return Err(e);
+        }
+        let marker = names.iter().position(|s| s == "shapers:");
+        let extra: Vec<usize> = (5..marker.unwrap_or(names.len())).collect();
+        let mut shapers = Vec::new();
+        if let Some(m) = marker {
+            for (j, name) in names.iter().enumerate().skip(m + 1) {
+                // `zv(59.8)`: name and frequency (`save_calibration_data` writes `%s(%.1f)`).
+                let parsed = name
+                    .strip_suffix(')')
+                    .and_then(|s| s.split_once('('))
+                    .and_then(|(a, f)| {
+                        f.parse::<f64>()
+                            .ok()
+                            .filter(|f| f.is_finite())
+                            .map(|f| (a.to_string(), f))
+                    });
+                let Some((shaper, freq)) = parsed else {
+                    return Err(RecordingError::field(
+                        n,
+                        j + 1,
+                        name,
+                        "a shaper column must be named `<shaper>(<frequency>)`, e.g. `mzv(52.4)`",
+                    ));
+                };
+                shapers.push((j, shaper, freq));
+            }
+        }
+        if let Some((j, name)) = names.iter().enumerate().find(|(_, s)| s.is_empty()) {
+            return Err(RecordingError::field(
+                n,
+                j + 1,
+                name,
+                "the header leaves this column unnamed",
+            ));
+        }
+        self.columns = vec![Vec::new(); names.len() - 1 - usize::from(marker.is_some())];
+        self.header = Some(Header {
+            names,
+            time: 0,
+            separator,
+            klipper: true,
+            spectrum: Some(SpectrumLayout {
+                marker,
+                extra,
+                shapers,
+            }),
+        });
+        self.header_line_seen = n;
+        Ok(())
+    }
+
+    /// Reads whatever is left, checks the recording and puts it on an even grid. A spectrum
+    /// file is an error here (read it with [`finish_any`](RecordingParser::finish_any)).
+    pub fn finish(self) -> Result<Recording, RecordingError> {
+        let line = self.header_line_seen;
+        match self.finish_any()? {
+            Parsed::Recording(r) => Ok(r),
+            Parsed::Spectrum(s) => Err(RecordingError {
+                file: s.file_name.clone(),
+                ..RecordingError::at(
+                    line,
+                    "this is a Klipper spectrum file, not a recording with a time column",
+                )
+            }),
+        }
+    }
+
+    /// Reads whatever is left: a recording (see [`finish`](RecordingParser::finish)) or a
+    /// Klipper spectrum file.
+    pub fn finish_any(self) -> Result<Parsed, RecordingError> {
+        let file = self.options.file_name.clone();
+        self.finish_inner().map_err(|mut e| {
+            if e.file.is_none() {
+                e.file = file;
+            }
+            e
+        })
+    }
+
+    fn finish_inner(mut self) -> Result<Parsed, RecordingError> {
         if let Some(e) = self.failed.take() {
             return Err(e);
         }
@@ -518,6 +717,9 @@ impl RecordingParser {
             ));
         };
         let n = self.times.len();
+        if let Some(layout) = header.spectrum.clone() {
+            return self.finish_spectrum(header, layout).map(Parsed::Spectrum);
+        }
         if n < 2 {
             return Err(RecordingError::at(
                 self.line.max(1),
@@ -556,7 +758,7 @@ impl RecordingParser {
                 },
             })
             .collect();
-        Ok(Recording {
+        Ok(Parsed::Recording(Recording {
             format: if header.klipper {
                 RecordingFormat::Klipper
             } else {
@@ -580,7 +782,85 @@ impl RecordingParser {
             } else {
                 self.times
             },
-        })
+        }))
+    }
+
+    fn finish_spectrum(
+        self,
+        header: Header,
+        layout: SpectrumLayout,
+    ) -> Result<SpectrumFile, RecordingError> {
+        let n = self.times.len();
+        if n < 2 {
+            return Err(RecordingError::at(
+                self.line.max(1),
+                format!(
+                    "{n} frequency row{}: a spectrum needs at least 2 bins",
+                    if n == 1 { "" } else { "s" }
+                ),
+            ));
+        }
+        // Data columns are the header's less `freq` and the `shapers:` marker.
+        let data_index = |j: usize| j - 1 - usize::from(layout.marker.is_some_and(|m| j > m));
+        let mut cols = self.columns;
+        let take = |cols: &mut Vec<Vec<f64>>, j: usize| std::mem::take(&mut cols[data_index(j)]);
+        let psd_x = take(&mut cols, 1);
+        let psd_y = take(&mut cols, 2);
+        let psd_z = take(&mut cols, 3);
+        let psd_sum = take(&mut cols, 4);
+        let extra = layout
+            .extra
+            .iter()
+            .map(|&j| Channel {
+                name: header.names[j].clone(),
+                values: take(&mut cols, j),
+            })
+            .collect();
+        let shapers: Vec<FittedShaper> = layout
+            .shapers
+            .iter()
+            .map(|(j, name, f)| FittedShaper {
+                name: name.clone(),
+                frequency_hz: *f,
+                values: take(&mut cols, *j),
+            })
+            .collect();
+        // As `calibrate_shaper.py`'s `parse_log`: a file with fitted shapers was normalised.
+        let normalized = !shapers.is_empty() || header.names.iter().any(|s| s.contains("mzv"));
+        let (resolution_hz, even) = resolution(&self.times);
+        let channel = self.options.channel;
+        let file = SpectrumFile {
+            format: if layout.marker.is_some() {
+                RecordingFormat::KlipperCalibration
+            } else {
+                RecordingFormat::KlipperResonances
+            },
+            file_name: self.options.file_name.clone(),
+            axis: self
+                .options
+                .file_name
+                .as_deref()
+                .and_then(axis_from_file_name),
+            frequency_hz: self.times,
+            psd_x,
+            psd_y,
+            psd_z,
+            psd_sum,
+            psd: Vec::new(),
+            channel,
+            normalization: if normalized {
+                Normalization::Klipper
+            } else {
+                Normalization::None
+            },
+            resolution_hz,
+            even,
+            shapers,
+            extra,
+            sources: 1,
+            segment_length: None,
+        };
+        Ok(file.with_channel(channel))
     }
 }
 
@@ -625,6 +905,13 @@ fn resample(t: &[f64], v: &[f64], step: f64) -> Vec<f64> {
                 + (s3 - s2) * mb
         })
         .collect()
+}
+
+/// Parses a whole file at once: a recording or a Klipper spectrum file.
+pub fn parse_file(text: &str, options: &RecordingOptions) -> Result<Parsed, RecordingError> {
+    let mut parser = RecordingParser::new(options.clone());
+    parser.push(text)?;
+    parser.finish_any()
 }
 
 /// Parses a whole recording at once (see the module docs).

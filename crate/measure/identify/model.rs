@@ -1,0 +1,438 @@
+//! Stage 3 (joint form): all modes fitted together to a PSD by the expected Welch estimate of
+//! a modal response to a smooth excitation.
+//!
+//! The model of bin k (frequency f_k):
+//!
+//! S_k = N(f_k) · [ Σ_j K_j · E(ν_j) |c + Σᵢ gᵢ (ν_j/fᵢ)^p fᵢ² / (fᵢ² − ν_j² + 2iζᵢfᵢν_j)|² + B ]
+//!
+//! - **Modal response**: the coherent sum Σᵢ gᵢHᵢ (real signed gains: classically damped modes
+//!   seen from one input, the sweep's axis, at one sensor), plus a direct term c (an
+//!   accelerometer on a base-driven structure also reads the drive itself: the transmissibility
+//!   (fₙ² + 2iζfₙf)/(fₙ² − f² + 2iζfₙf) is 1 + a p = 2 mode term). The coherent sum, rather than
+//!   the sum of modal powers, because a sweep drives every mode from the same input: their
+//!   responses add with their phases, so two modes of opposite gains leave an anti-resonance
+//!   between them that the sum of powers would fill in. For `psd_xyz` (three sensors) the sum is
+//!   the sum over three such responses; the one coherent sum then stands for them.
+//! - **Excitation**: E(f) = (f/f_ref)^a, its exponent fitted (a sweep at constant Hz/s with an
+//!   acceleration ∝ f, as Klipper's resonance test drives the toolhead, gives a ≈ 2; white
+//!   noise a = 0; a hit a ≈ 0), its level carried by the gains.
+//! - **Noise floor** B (white sensor noise).
+//! - **Window**: the expected Welch estimate is the true PSD convolved with the window's
+//!   spectral kernel |W(ν)|²/Σ|W|² (Welch 1967 eq. 7). K_j samples it every Δf/q over ±5
+//!   bins, q chosen so the narrowest half-power width spans ≥ 6 fine steps (a ζ = 0.01 mode at
+//!   50 Hz is 1 Hz wide, against Klipper's 1.56 Hz bins).
+//! - **Klipper's normalisation** N(f) = 1/(f + 0.1) when the file has it applied (bins where
+//!   Klipper zeroed the PSD, below 5 Hz, are left out).
+//!
+//! The fit minimises Σ (ln P_k − ln S_k)² (Levenberg–Marquardt, [`crate::measure::fit`]); in
+//! log the residuals of a Welch estimate have a constant variance (≈ ψ′(K) for K segments)
+//! whatever the level, so peaks and flanks weigh alike. Seeds come from the peaks; then the
+//! largest positive residual bump away from the fitted modes (a mode hidden on a neighbour's
+//! flank) is tried as one more mode and kept when the Bayesian information criterion, with the
+//! bins counted as n/ENBW independent ones, falls by more than 10. Uncertainties:
+//! s²(JᵀJ)⁻¹, inflated by √ENBW (neighbouring bins are correlated through the window).
+
+use super::{Estimate, Method, SignalKind};
+use crate::measure::fft::Complex;
+use crate::measure::fit::{levenberg_marquardt, FitResult};
+use crate::measure::psd::{window, WindowKind};
+use std::f64::consts::PI;
+
+/// The window a PSD was estimated with.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct WindowSpec {
+    pub kind: WindowKind,
+    pub length: usize,
+    pub symmetric: bool,
+    pub beta: f64,
+}
+
+/// A spectrum to fit: bins on an even grid f_k = f₀ + kΔf (or uneven: no kernel).
+pub(crate) struct ModelInput<'a> {
+    pub frequency_hz: &'a [f64],
+    pub psd: &'a [f64],
+    pub resolution_hz: f64,
+    pub even: bool,
+    pub window: Option<WindowSpec>,
+    pub klipper_normalized: bool,
+    pub kind: SignalKind,
+    /// Equivalent noise bandwidth of the window, bins.
+    pub enbw_bins: f64,
+    /// The band searched, Hz.
+    pub band: [f64; 2],
+}
+
+/// A seed: natural frequency, damping, PSD at the peak.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Seed {
+    pub frequency_hz: f64,
+    pub damping: f64,
+    pub peak_psd: f64,
+    /// Index of the detected peak it came from (None: found in the residuals).
+    pub peak: Option<usize>,
+}
+
+/// A fitted mode.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FittedMode {
+    pub estimate: Estimate,
+    pub peak: Option<usize>,
+    /// The model's PSD at fₙ.
+    pub peak_psd: f64,
+    /// The mode's own peak over the model without it, dB.
+    pub standing_db: f64,
+}
+
+const SPAN_BINS: usize = 5;
+
+/// |W(ν)|² at ν = (jj − J)/q bins, jj = 0 … 2J, J = SPAN_BINS·q, normalised to sum 1. The
+/// window is evaluated at ≤ 2048 points: in bin units the kernel hardly depends on the length.
+fn kernel(spec: WindowSpec, q: usize) -> Vec<f64> {
+    let n = spec.length.clamp(16, 2048);
+    let w = window(spec.kind, n, spec.symmetric, spec.beta);
+    let j_max = SPAN_BINS * q;
+    let half: Vec<f64> = (0..=j_max)
+        .map(|j| {
+            let nu = j as f64 / q as f64;
+            let mut acc = Complex::default();
+            for (i, &wi) in w.iter().enumerate() {
+                acc = acc + Complex::cis(-2.0 * PI * nu * i as f64 / n as f64) * wi;
+            }
+            acc.norm_sqr()
+        })
+        .collect();
+    let mut out: Vec<f64> = (0..=2 * j_max).map(|jj| half[jj.abs_diff(j_max)]).collect();
+    let s: f64 = out.iter().sum();
+    out.iter_mut().for_each(|v| *v /= s);
+    out
+}
+
+/// The model without kernel and normalisation at frequency f: E(f)|c + ΣgH|².
+fn response(x: &[f64], m: usize, power: i32, f_ref: f64, f: f64) -> f64 {
+    let f = f.abs().max(1e-9);
+    let mut h = Complex::new(x[3 * m], 0.0);
+    for i in 0..m {
+        let fi = x[3 * i].exp();
+        let z = x[3 * i + 1].exp();
+        let g = x[3 * i + 2];
+        let den = Complex::new(fi * fi - f * f, 2.0 * z * fi * f);
+        let num = g * (f / fi).powi(power) * fi * fi / den.norm_sqr();
+        h = h + den.conj() * num;
+    }
+    (x[3 * m + 1] * (f / f_ref).ln()).exp() * h.norm_sqr()
+}
+
+struct Problem<'a> {
+    input: &'a ModelInput<'a>,
+    bins: Vec<usize>,
+    logs: Vec<f64>,
+    f_ref: f64,
+    power: i32,
+}
+
+impl Problem<'_> {
+    /// Model values at the problem's bins for parameters x with m modes.
+    fn eval(&self, x: &[f64], m: usize, q: usize, kern: &[f64], out: &mut Vec<f64>) -> bool {
+        out.clear();
+        let inp = self.input;
+        let floor = x[3 * m + 2].exp();
+        if kern.is_empty() {
+            for &k in &self.bins {
+                let f = inp.frequency_hz[k];
+                out.push(self.norm(f) * (response(x, m, self.power, self.f_ref, f) + floor));
+            }
+        } else {
+            let df = inp.resolution_hz;
+            let j_max = SPAN_BINS * q;
+            let (k0, k1) = (self.bins[0], self.bins[self.bins.len() - 1]);
+            let f0 = inp.frequency_hz[0];
+            let grid0 = (k0 * q) as f64 - j_max as f64;
+            let count = (k1 - k0) * q + 2 * j_max + 1;
+            let fine: Vec<f64> = (0..count)
+                .map(|t| {
+                    let f = f0 + (grid0 + t as f64) * df / q as f64;
+                    response(x, m, self.power, self.f_ref, f)
+                })
+                .collect();
+            for &k in &self.bins {
+                let start = (k - k0) * q;
+                let conv: f64 = kern
+                    .iter()
+                    .zip(&fine[start..start + kern.len()])
+                    .map(|(a, b)| a * b)
+                    .sum();
+                let f = f0 + k as f64 * df;
+                out.push(self.norm(f) * (conv + floor));
+            }
+        }
+        out.iter().all(|v| v.is_finite() && *v > 0.0)
+    }
+
+    fn norm(&self, f: f64) -> f64 {
+        if self.input.klipper_normalized {
+            1.0 / (f + 0.1)
+        } else {
+            1.0
+        }
+    }
+
+    fn fit(&self, x0: &[f64], m: usize) -> Option<(FitResult, usize)> {
+        let mut q = self.q_for(x0, m);
+        let mut start = x0.to_vec();
+        let mut result = None;
+        for _ in 0..3 {
+            let kern = match self.input.window {
+                Some(w) if self.input.even => kernel(w, q),
+                _ => Vec::new(),
+            };
+            let mut buf = Vec::new();
+            let residual = |x: &[f64], out: &mut Vec<f64>| -> bool {
+                for i in 0..m {
+                    let z = x[3 * i + 1];
+                    if !(z < 0.0 && z > -12.0) {
+                        return false;
+                    }
+                }
+                if !self.eval(x, m, q, &kern, &mut buf) {
+                    return false;
+                }
+                out.clear();
+                out.extend(self.logs.iter().zip(&buf).map(|(l, s)| l - s.ln()));
+                true
+            };
+            let scale = (0..m)
+                .map(|i| start[3 * i + 2].abs())
+                .fold(1e-300, f64::max);
+            let steps: Vec<f64> = (0..3 * m + 3)
+                .map(|i| {
+                    if i < 3 * m {
+                        match i % 3 {
+                            0 => 1e-7,
+                            1 => 1e-5,
+                            _ => 1e-6 * start[i].abs().max(1e-3 * scale),
+                        }
+                    } else if i == 3 * m {
+                        1e-6 * scale
+                    } else {
+                        1e-5
+                    }
+                })
+                .collect();
+            let fit = levenberg_marquardt(residual, &start, &steps, 100)?;
+            let q_new = self.q_for(&fit.x, m);
+            let done = q_new <= q;
+            start = fit.x.clone();
+            result = Some((fit, q));
+            if done {
+                break;
+            }
+            q = q_new;
+        }
+        result
+    }
+
+    /// Fine steps per bin so that the narrowest mode's half-power width spans ≥ 6 of them.
+    fn q_for(&self, x: &[f64], m: usize) -> usize {
+        let df = self.input.resolution_hz;
+        let narrowest = (0..m)
+            .map(|i| 2.0 * x[3 * i + 1].exp() * x[3 * i].exp())
+            .fold(f64::INFINITY, f64::min);
+        ((6.0 * df / narrowest).ceil() as usize).clamp(4, 64)
+    }
+}
+
+fn bic(fit: &FitResult, n_eff: f64) -> f64 {
+    let n = fit.residuals as f64;
+    n_eff * (fit.rss / n).max(1e-300).ln() + fit.x.len() as f64 * n_eff.ln()
+}
+
+/// Initial parameters from seeds, with gain signs from `signs` (bit i−1 flips mode i).
+fn start(seeds: &[Seed], signs: usize, floor: f64) -> Vec<f64> {
+    let mut x = Vec::with_capacity(3 * seeds.len() + 3);
+    for (i, s) in seeds.iter().enumerate() {
+        let sign = if i > 0 && (signs >> (i - 1)) & 1 == 1 {
+            -1.0
+        } else {
+            1.0
+        };
+        let z = s.damping.clamp(2e-3, 0.5);
+        x.push(s.frequency_hz.ln());
+        x.push(z.ln());
+        x.push(sign * (s.peak_psd - floor).max(floor).sqrt() * 2.0 * z);
+    }
+    x.push(0.0); // c
+    x.push(0.0); // a
+    x.push(floor.max(1e-300).ln());
+    x
+}
+
+/// Fits the modes from `seeds` jointly, then adds modes found in the residuals while the
+/// information criterion says so (up to `max_modes`). None when no fit converged.
+pub(crate) fn fit_modes(
+    input: &ModelInput,
+    seeds: &[Seed],
+    max_modes: usize,
+) -> Option<Vec<FittedMode>> {
+    if seeds.is_empty() {
+        return None;
+    }
+    let df = input.resolution_hz;
+    let f = input.frequency_hz;
+    // The fitted range: around every seed, ±max(8ζ, 35 %), inside the band.
+    let range = |seeds: &[Seed]| -> (f64, f64) {
+        let lo = seeds
+            .iter()
+            .map(|s| s.frequency_hz * (1.0 - (8.0 * s.damping).clamp(0.35, 0.8)))
+            .fold(f64::INFINITY, f64::min);
+        let hi = seeds
+            .iter()
+            .map(|s| s.frequency_hz * (1.0 + (8.0 * s.damping).max(0.35)))
+            .fold(0.0, f64::max);
+        (lo.max(input.band[0]), hi.min(input.band[1]))
+    };
+    let (lo, hi) = range(seeds);
+    let bins: Vec<usize> = (0..f.len())
+        .filter(|&k| f[k] >= lo && f[k] <= hi && input.psd[k] > 0.0 && input.psd[k].is_finite())
+        .filter(|&k| {
+            !input.klipper_normalized || f[k] >= super::super::spectrum_file::KLIPPER_MIN_FREQ_HZ
+        })
+        .collect();
+    if bins.len() < 3 * seeds.len() + 6 {
+        return None;
+    }
+    // With the kernel the bins must be contiguous (the fine grid spans them).
+    let problem = Problem {
+        input,
+        logs: bins.iter().map(|&k| input.psd[k].ln()).collect(),
+        f_ref: (lo * hi).sqrt(),
+        power: input.kind.power(),
+        bins,
+    };
+    let floor = {
+        let mut v: Vec<f64> = problem
+            .bins
+            .iter()
+            .map(|&k| input.psd[k] / problem.norm(f[k]))
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 10].max(1e-300) * 0.3
+    };
+    let n_eff = problem.bins.len() as f64 / input.enbw_bins.max(1.0);
+    let run = |seeds: &[Seed]| -> Option<(FitResult, usize)> {
+        let m = seeds.len();
+        let patterns = if m <= 4 { 1usize << (m - 1) } else { 1 };
+        let mut best: Option<(FitResult, usize)> = None;
+        for signs in 0..patterns {
+            let x0 = start(seeds, signs, floor);
+            if let Some(r) = problem.fit(&x0, m) {
+                if best.as_ref().is_none_or(|b| r.0.rss < b.0.rss) {
+                    best = Some(r);
+                }
+            }
+        }
+        best
+    };
+    let mut seeds = seeds.to_vec();
+    let mut best = run(&seeds)?;
+    // Residual search: one more mode at the largest positive residual away from the modes.
+    while seeds.len() < max_modes {
+        let m = seeds.len();
+        let x = &best.0.x;
+        let mut model = Vec::new();
+        let kern = match input.window {
+            Some(w) if input.even => kernel(w, best.1),
+            _ => Vec::new(),
+        };
+        if !problem.eval(x, m, best.1, &kern, &mut model) {
+            break;
+        }
+        let res: Vec<f64> = problem
+            .logs
+            .iter()
+            .zip(&model)
+            .map(|(l, s)| l - s.ln())
+            .collect();
+        let n = res.len();
+        let sm: Vec<f64> = (0..n)
+            .map(|i| {
+                let a = i.saturating_sub(1);
+                let b = (i + 1).min(n - 1);
+                res[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
+            })
+            .collect();
+        let away = |fk: f64| {
+            (0..m).all(|i| {
+                let fi = x[3 * i].exp();
+                let w = (2.0 * x[3 * i + 1].exp() * fi).max(1.5 * df);
+                (fk - fi).abs() > w
+            })
+        };
+        let Some((i_max, &r_max)) = sm
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| away(f[problem.bins[*i]]))
+            .max_by(|a, b| a.1.total_cmp(b.1))
+        else {
+            break;
+        };
+        if r_max < 0.3 {
+            break;
+        }
+        let fk = f[problem.bins[i_max]];
+        let seed = Seed {
+            frequency_hz: fk,
+            damping: (1.5 * df / fk).max(0.02),
+            peak_psd: input.psd[problem.bins[i_max]] / problem.norm(fk),
+            peak: None,
+        };
+        let mut trial = seeds.clone();
+        trial.push(seed);
+        let Some(candidate) = run(&trial) else {
+            break;
+        };
+        if bic(&candidate.0, n_eff) < bic(&best.0, n_eff) - 10.0 {
+            seeds = trial;
+            best = candidate;
+        } else {
+            break;
+        }
+    }
+    let (fit, q) = best;
+    let m = seeds.len();
+    let inflate = input.enbw_bins.max(1.0).sqrt();
+    let kern = match input.window {
+        Some(w) if input.even => kernel(w, q),
+        _ => Vec::new(),
+    };
+    let mut out = Vec::new();
+    for i in 0..m {
+        let fi = fit.x[3 * i].exp();
+        let z = fit.x[3 * i + 1].exp();
+        let (Some(sf), Some(sz)) = (fit.sigma(3 * i), fit.sigma(3 * i + 1)) else {
+            continue;
+        };
+        if !(fi.is_finite() && fi > lo && fi < hi && z > 0.0 && z < 0.7) {
+            continue;
+        }
+        // How far the mode stands over the model without it, at its frequency.
+        let mut without = fit.x.clone();
+        without[3 * i + 2] = 0.0;
+        let at =
+            |x: &[f64]| response(x, m, problem.power, problem.f_ref, fi) + fit.x[3 * m + 2].exp();
+        let standing_db = 10.0 * (at(&fit.x) / at(&without).max(1e-300)).log10();
+        let _ = &kern;
+        out.push(FittedMode {
+            estimate: Estimate {
+                method: Method::SpectrumFit,
+                frequency_hz: fi,
+                damping: z,
+                frequency_uncertainty_hz: sf * inflate * fi,
+                damping_uncertainty: sz * inflate * z,
+            },
+            peak: seeds[i].peak,
+            peak_psd: problem.norm(fi) * at(&fit.x),
+            standing_db,
+        });
+    }
+    Some(out)
+}
