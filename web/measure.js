@@ -56,7 +56,6 @@ export function setupMeasure(h) {
     load(e.dataTransfer?.files ?? []);
   });
   drop.addEventListener('keydown', (e) => { if (e.key === 'Enter' || e.key === ' ') { e.preventDefault(); input.click(); } });
-  $('open-recording').addEventListener('click', (e) => { e.preventDefault(); openPath(); });
-  if (location.hash === '#measure') openPath();
+  $('open-recording').addEventListener('click', openPath);
   window.__measure = { load: (files) => load(Array.isArray(files) ? files : [files]), open: openView };
 }

@@ -119,7 +119,9 @@ function onMessage({ data }) {
     status(`Analysing ${data.rows.toLocaleString('en')} samples…`);
   } else if (data.type === 'error') {
     progress.hidden = true;
-    showError(`Could not read ${data.file ?? fileNames}: ${data.message.replace(/^recording: /, '')}`);
+    const message = data.message.replace(/^recording(?: \(([^)]*)\))?: /, (_, where) => (where ? `${where}: ` : ''));
+    // The parser's message names the file when it knows it ("`a.csv`, line 3, column 2 …").
+    showError(data.file && message.includes(`\`${data.file}\``) ? `Could not read ${message}` : `Could not read ${data.file ?? fileNames}: ${message}`);
     status(result ? 'The previous result is still shown.' : '');
   } else if (data.type === 'fft') {
     fft = data.spectrum;

@@ -30,7 +30,7 @@ function summary(r) {
 }
 
 async function read(id, file, done, total) {
-  const parser = new RecordingParser({});
+  const parser = new RecordingParser({ fileName: file.name });
   const decoder = new TextDecoder('utf-8');
   try {
     for (let offset = 0; offset < file.size; offset += CHUNK_BYTES) {
