@@ -261,6 +261,8 @@ struct SpectrumLayout {
     extra: Vec<usize>,
     /// The shapers' (column, name, frequency).
     shapers: Vec<(usize, String, f64)>,
+    /// The columns between `freq` and `shapers:` are runs (`psd_xyz` each), not x, y, z, sum.
+    runs: bool,
 }
 
 /// What a file held: a recording or a spectrum.
@@ -446,7 +448,7 @@ impl RecordingParser {
                     format!("`{field}` is not a finite number"),
                 ));
             }
-            if header.spectrum.is_some() {
+            if let Some(layout) = &header.spectrum {
                 if j == 0 {
                     if let Some(&prev) = self.times.last() {
                         if value <= prev {
@@ -460,7 +462,12 @@ impl RecordingParser {
                     }
                     self.times.push(value);
                 } else {
-                    if (1..=4).contains(&j) && value < 0.0 {
+                    let is_psd = if layout.runs {
+                        layout.extra.contains(&j)
+                    } else {
+                        (1..=4).contains(&j)
+                    };
+                    if is_psd && value < 0.0 {
                         return Err(RecordingError::field(
                             n,
                             j + 1,
@@ -527,15 +534,10 @@ impl RecordingParser {
         {
             return self.spectrum_header(names, separator);
         }
-        if names.first().map(|s| s.as_str()) == Some("freq") {
-            return Err(RecordingError::at(
-                n,
-                format!(
-                    "a spectrum with the columns `{}` is not read: Klipper's spectrum files start \
-                     `freq,psd_x,psd_y,psd_z,psd_xyz`",
-                    names.join(",")
-                ),
-            ));
+        if names.first().map(|s| s.as_str()) == Some("freq") && names.len() >= 2 {
+            // Klipper's current `save_calibration_data` with several runs: one `psd_xyz`
+            // column per run, named after it.
+            return self.spectrum_header(names, separator);
         }
         let wanted = self.options.time_column.as_deref();
         let time = names.iter().position(|s| is_time_name(s, wanted));
@@ -621,7 +623,15 @@ impl RecordingParser {
             return Err(e);
         }
         let marker = names.iter().position(|s| s == "shapers:");
-        let extra: Vec<usize> = (5..marker.unwrap_or(names.len())).collect();
+        let runs = names.get(1).map(String::as_str) != Some("psd_x");
+        let first_extra = if runs { 1 } else { 5 };
+        let extra: Vec<usize> = (first_extra..marker.unwrap_or(names.len())).collect();
+        if runs && extra.is_empty() {
+            return Err(RecordingError::at(
+                n,
+                "a spectrum file needs at least one PSD column after `freq`",
+            ));
+        }
         let mut shapers = Vec::new();
         if let Some(m) = marker {
             for (j, name) in names.iter().enumerate().skip(m + 1) {
@@ -664,6 +674,7 @@ impl RecordingParser {
                 marker,
                 extra,
                 shapers,
+                runs,
             }),
         });
         self.header_line_seen = n;
@@ -804,11 +815,17 @@ impl RecordingParser {
         let data_index = |j: usize| j - 1 - usize::from(layout.marker.is_some_and(|m| j > m));
         let mut cols = self.columns;
         let take = |cols: &mut Vec<Vec<f64>>, j: usize| std::mem::take(&mut cols[data_index(j)]);
-        let psd_x = take(&mut cols, 1);
-        let psd_y = take(&mut cols, 2);
-        let psd_z = take(&mut cols, 3);
-        let psd_sum = take(&mut cols, 4);
-        let extra = layout
+        let (psd_x, psd_y, psd_z, psd_sum) = if layout.runs {
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new())
+        } else {
+            (
+                take(&mut cols, 1),
+                take(&mut cols, 2),
+                take(&mut cols, 3),
+                take(&mut cols, 4),
+            )
+        };
+        let extra: Vec<Channel> = layout
             .extra
             .iter()
             .map(|&j| Channel {
@@ -828,7 +845,21 @@ impl RecordingParser {
         // As `calibrate_shaper.py`'s `parse_log`: a file with fitted shapers was normalised.
         let normalized = !shapers.is_empty() || header.names.iter().any(|s| s.contains("mzv"));
         let (resolution_hz, even) = resolution(&self.times);
-        let channel = self.options.channel;
+        let (runs, extra) = if layout.runs {
+            (extra, Vec::new())
+        } else {
+            (Vec::new(), extra)
+        };
+        let (psd_sum, channel) = if layout.runs {
+            let k = runs.len() as f64;
+            let mean = (0..n)
+                .map(|i| runs.iter().map(|r| r.values[i]).sum::<f64>() / k)
+                .collect();
+            (mean, SpectrumChannel::Sum)
+        } else {
+            (psd_sum, self.options.channel)
+        };
+        let sources = runs.len().max(1);
         let file = SpectrumFile {
             format: if layout.marker.is_some() {
                 RecordingFormat::KlipperCalibration
@@ -857,7 +888,8 @@ impl RecordingParser {
             even,
             shapers,
             extra,
-            sources: 1,
+            runs,
+            sources,
             segment_length: None,
         };
         Ok(file.with_channel(channel))

@@ -10,7 +10,7 @@
 //!   `,shapers:` and one `,<name>(<freq>)` per fitted shaper; each row with an empty field and
 //!   each shaper's remaining-vibration ratio at that frequency (`%.3f`). `SHAPER_CALIBRATE`
 //!   calls `CalibrationData.normalize_to_frequencies` before writing, so these PSDs are divided
-//!   by f + 0.1 and zero below 5 Hz ([`Normalization::Klipper`]). `scripts/calibrate_shaper.py`
+//!   by f + 0.1 and tapered below 10 Hz ([`Normalization::Klipper`], see [`klipper_normalize`]). `scripts/calibrate_shaper.py`
 //!   (`parse_log`) decides the same way: a header naming `mzv` (a shaper) is taken as already
 //!   normalised, any other is normalised on reading.
 //!
@@ -55,7 +55,7 @@ pub enum Normalization {
     /// The PSD as Welch computed it.
     #[default]
     None,
-    /// Divided by f + 0.1 and zero below 5 Hz (`CalibrationData.normalize_to_frequencies`).
+    /// Divided by f + 0.1 and tapered below 10 Hz (see [`klipper_normalize`]).
     Klipper,
 }
 
@@ -106,6 +106,11 @@ pub struct SpectrumFile {
     pub shapers: Vec<FittedShaper>,
     /// Other columns (e.g. `accel_per_hz`).
     pub extra: Vec<Channel>,
+    /// Each run's `psd_xyz` on these bins, when several were combined (or a Klipper file of
+    /// several runs, `freq,<run>,<run>,…`, was read: then `psd_sum` is their mean and
+    /// `psd_x`, `psd_y`, `psd_z` are empty). Klipper's current `fit_shaper` takes the worst
+    /// shaper response over them.
+    pub runs: Vec<Channel>,
     /// Runs combined into this spectrum (1 for one file).
     pub sources: usize,
     /// Segment length of the Welch estimate, when known (raw recordings).
@@ -161,15 +166,18 @@ impl SpectrumFile {
     }
 }
 
-/// Klipper's `normalize_to_frequencies` (released versions): psd /= f + 0.1, and 0 below
-/// [`KLIPPER_MIN_FREQ_HZ`].
+/// Klipper's `normalize_to_frequencies` as the current source has it
+/// (`klippy/extras/shaper_calibrate.py`, `CalibrationData.normalize_to_frequencies`):
+/// psd /= f + 0.1, and below 2·[`KLIPPER_MIN_FREQ_HZ`] = 10 Hz also psd ·= e^{1 − (10/(f + 0.1))²}.
+/// (Klipper's releases before 2024 set the PSD to 0 below 5 Hz instead; the two agree above
+/// 10 Hz, the only part [`crate::measure::identify::identify_spectrum`] fits.)
 pub fn klipper_normalize(frequency_hz: &[f64], psd: &mut [f64]) {
+    let low = 2.0 * KLIPPER_MIN_FREQ_HZ;
     for (p, &f) in psd.iter_mut().zip(frequency_hz) {
-        *p = if f < KLIPPER_MIN_FREQ_HZ {
-            0.0
-        } else {
-            *p / (f + 0.1)
-        };
+        *p /= f + 0.1;
+        if f < low {
+            *p *= (1.0 - (low / (f + 0.1)).powi(2)).exp();
+        }
     }
 }
 
@@ -258,6 +266,7 @@ pub fn klipper_spectrum(recording: &Recording, channel: SpectrumChannel) -> Resu
         normalization: Normalization::None,
         shapers: Vec::new(),
         extra: Vec::new(),
+        runs: Vec::new(),
         sources: 1,
         segment_length: Some(m),
     };
@@ -320,6 +329,21 @@ pub fn combine_spectra(files: &[SpectrumFile]) -> Result<Vec<SpectrumFile>> {
                 out.shapers.clear();
                 out.extra.clear();
                 out.file_name = None;
+                let f = out.frequency_hz.clone();
+                out.runs = prepared
+                    .iter()
+                    .enumerate()
+                    .map(|(i, r)| Channel {
+                        name: r
+                            .file_name
+                            .clone()
+                            .unwrap_or_else(|| format!("run {}", i + 1)),
+                        values: f
+                            .iter()
+                            .map(|&x| interp(&r.frequency_hz, &r.psd_sum, x))
+                            .collect(),
+                    })
+                    .collect();
             }
             for other in &prepared[1..] {
                 let (a, b) = (out.sources as f64, other.sources as f64);
@@ -330,9 +354,15 @@ pub fn combine_spectra(files: &[SpectrumFile]) -> Result<Vec<SpectrumFile>> {
                         *v = (*v * a + o * b) / (a + b);
                     }
                 };
-                join(&mut out.psd_x, &other.psd_x);
-                join(&mut out.psd_y, &other.psd_y);
-                join(&mut out.psd_z, &other.psd_z);
+                if out.psd_x.len() == f.len() && other.psd_x.len() == other.frequency_hz.len() {
+                    join(&mut out.psd_x, &other.psd_x);
+                    join(&mut out.psd_y, &other.psd_y);
+                    join(&mut out.psd_z, &other.psd_z);
+                } else {
+                    out.psd_x.clear();
+                    out.psd_y.clear();
+                    out.psd_z.clear();
+                }
                 join(&mut out.psd_sum, &other.psd_sum);
                 out.sources += other.sources;
                 out.segment_length = out

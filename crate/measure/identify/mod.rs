@@ -353,6 +353,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
             hi0,
             options.min_prominence_db,
             options.max_modes,
+            3,
         )
     } else {
         Vec::new()
@@ -518,5 +519,177 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         a.frequency_hz.total_cmp(&b.frequency_hz)
     });
     result.spectrum = psd;
+    Ok(result)
+}
+
+/// Identifies the modes in a spectrum alone (a Klipper spectrum file, or a raw file's Klipper
+/// spectrum): the peaks of `spectrum.psd` (3-bin smoothing: Klipper's bins are coarse) seed the
+/// joint fit of [`model`], which models Klipper's Welch window (symmetric Kaiser β = 6) and,
+/// when `spectrum.normalization` says so, its normalisation (fitted above 10 Hz only, where the
+/// released and the current Klipper agree: psd/(f + 0.1)). `options.sampleRateHz` is not used;
+/// the band defaults to [5 Hz or the second bin, the last bin].
+///
+/// Errors: fewer than 8 bins, an uneven or non-increasing frequency column, a negative or
+/// non-finite PSD (`spectrum.psd[i]`), and the option errors of [`identify`].
+pub fn identify_spectrum(
+    spectrum: &super::spectrum_file::SpectrumFile,
+    options: &IdentifyOptions,
+) -> Result<Identification> {
+    use super::spectrum_file::{resolution, Normalization};
+    count("maxModes", options.max_modes, 1, MAX_MODES)?;
+    finite("minProminenceDb", options.min_prominence_db)?;
+    let f = &spectrum.frequency_hz;
+    let p = &spectrum.psd;
+    count(
+        "spectrum.frequencyHz",
+        f.len(),
+        8,
+        super::psd::MAX_SEGMENT_LENGTH,
+    )?;
+    if p.len() != f.len() {
+        return Err(Error::invalid(
+            "spectrum.psd",
+            format!("has {} values for {} frequencies", p.len(), f.len()),
+        ));
+    }
+    if let Some(i) = p.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+        return Err(Error::invalid(
+            format!("spectrum.psd[{i}]"),
+            format!("must be a finite number ≥ 0, got {}", p[i]),
+        ));
+    }
+    if let Some(i) = f.windows(2).position(|w| !(w[1] > w[0])) {
+        return Err(Error::invalid(
+            format!("spectrum.frequencyHz[{}]", i + 1),
+            "frequencies must increase",
+        ));
+    }
+    let (df, even) = resolution(f);
+    if !even {
+        return Err(Error::invalid(
+            "spectrum.frequencyHz",
+            "the bins are not evenly spaced",
+        ));
+    }
+    // The grid from 0: f_k = k·Δf (Klipper's rows start at bin 0; a file starting later gets
+    // empty bins in front).
+    let k0 = (f[0] / df).round().max(0.0) as usize;
+    let n = k0 + f.len();
+    let grid: Vec<f64> = (0..n).map(|k| k as f64 * df).collect();
+    let mut psd_full = vec![0.0; k0];
+    psd_full.extend_from_slice(p);
+    let normalized = spectrum.normalization == Normalization::Klipper;
+    let segment = spectrum
+        .segment_length
+        .unwrap_or_else(|| (2 * (n - 1)).next_power_of_two().max(256));
+    let kaiser = WindowSpec {
+        kind: WindowKind::Kaiser,
+        length: segment,
+        symmetric: true,
+        beta: 6.0,
+    };
+    let w = super::psd::window(WindowKind::Kaiser, 2048, true, 6.0);
+    let (s1, s2) = w.iter().fold((0.0, 0.0), |(a, b), v| (a + v, b + v * v));
+    let enbw = 2048.0 * s2 / (s1 * s1);
+    let psd = Psd {
+        frequency_hz: grid,
+        psd: psd_full,
+        segment_length: segment,
+        overlap: segment / 2,
+        segments: 0,
+        resolution_hz: df,
+        enbw_bins: enbw,
+        sample_rate_hz: df * segment as f64,
+    };
+    let lowest: f64 = if normalized { 10.0 } else { 5.0 };
+    let f_lo = match options.min_frequency_hz {
+        Some(v) => positive("minFrequencyHz", v)?,
+        None => lowest.max(2.0 * df),
+    };
+    let f_hi = match options.max_frequency_hz {
+        Some(v) => positive("maxFrequencyHz", v)?,
+        None => (n - 1) as f64 * df,
+    };
+    if f_lo >= f_hi {
+        return Err(Error::invalid(
+            "minFrequencyHz",
+            format!("must be below maxFrequencyHz ({f_hi} Hz), got {f_lo}"),
+        ));
+    }
+    let lo = ((f_lo / df).ceil() as usize).clamp(1, n - 1);
+    let hi = ((f_hi / df).floor() as usize).min(n - 1);
+    let mut result = Identification {
+        modes: Vec::new(),
+        spectrum: psd.clone(),
+        detection_segment_length: segment,
+        band_hz: [f_lo, f_hi],
+        free_decay: None,
+    };
+    if hi < lo + 4 {
+        return Ok(result);
+    }
+    // Peaks of the spectrum with Klipper's normalisation undone (the modal peaks are those of
+    // the un-normalised PSD).
+    let unnormalized = Psd {
+        psd: psd
+            .psd
+            .iter()
+            .zip(&psd.frequency_hz)
+            .map(|(v, f)| if normalized { v * (f + 0.1) } else { *v })
+            .collect(),
+        ..psd.clone()
+    };
+    let peaks = detect(
+        &unnormalized,
+        lo,
+        hi,
+        options.min_prominence_db,
+        options.max_modes,
+        1,
+    );
+    let mut slots = Vec::new();
+    let mut halves = Vec::new();
+    for pk in &peaks {
+        let search = 2.0 * df;
+        if let Some(h) = half_power(
+            &unnormalized,
+            pk.frequency_hz,
+            search,
+            lo,
+            hi,
+            options.signal,
+        ) {
+            if !halves
+                .iter()
+                .any(|o: &HalfPower| (o.peak_hz - h.peak_hz).abs() < df)
+            {
+                // Leakage widens a narrow peak to the kernel's width: the seed's damping is an
+                // upper bound, kept as it is.
+                halves.push(h);
+                slots.push(Slot {
+                    peak_hz: h.peak_hz,
+                    peak_psd: h.peak_psd,
+                    prominence_db: pk.prominence_db,
+                    estimates: vec![h.estimate],
+                });
+            }
+        }
+    }
+    let input = ModelInput {
+        frequency_hz: &psd.frequency_hz,
+        psd: &psd.psd,
+        resolution_hz: df,
+        even: true,
+        window: Some(kaiser),
+        klipper_normalized: normalized,
+        kind: options.signal,
+        enbw_bins: enbw,
+        band: [f_lo, f_hi],
+    };
+    joint_fit(&input, &halves, options.max_modes, &mut slots);
+    result.modes = slots.into_iter().map(Slot::into_mode).collect();
+    crate::sort::sort_by(&mut result.modes, |a, b| {
+        a.frequency_hz.total_cmp(&b.frequency_hz)
+    });
     Ok(result)
 }

@@ -247,7 +247,7 @@ fn bic(fit: &FitResult, n_eff: f64) -> f64 {
 }
 
 /// Initial parameters from seeds, with gain signs from `signs` (bit i−1 flips mode i).
-fn start(seeds: &[Seed], signs: usize, floor: f64) -> Vec<f64> {
+fn start(seeds: &[Seed], signs: usize, floor: f64, direct: f64) -> Vec<f64> {
     let mut x = Vec::with_capacity(3 * seeds.len() + 3);
     for (i, s) in seeds.iter().enumerate() {
         let sign = if i > 0 && (signs >> (i - 1)) & 1 == 1 {
@@ -260,7 +260,7 @@ fn start(seeds: &[Seed], signs: usize, floor: f64) -> Vec<f64> {
         x.push(z.ln());
         x.push(sign * (s.peak_psd - floor).max(floor).sqrt() * 2.0 * z);
     }
-    x.push(0.0); // c
+    x.push(direct); // c
     x.push(0.0); // a
     x.push(floor.max(1e-300).ln());
     x
@@ -282,11 +282,11 @@ pub(crate) fn fit_modes(
     let range = |seeds: &[Seed]| -> (f64, f64) {
         let lo = seeds
             .iter()
-            .map(|s| s.frequency_hz * (1.0 - (8.0 * s.damping).clamp(0.35, 0.8)))
+            .map(|s| s.frequency_hz * (1.0 - (8.0 * s.damping).clamp(0.6, 0.8)))
             .fold(f64::INFINITY, f64::min);
         let hi = seeds
             .iter()
-            .map(|s| s.frequency_hz * (1.0 + (8.0 * s.damping).max(0.35)))
+            .map(|s| s.frequency_hz * (1.0 + (8.0 * s.damping).max(0.8)))
             .fold(0.0, f64::max);
         (lo.max(input.band[0]), hi.min(input.band[1]))
     };
@@ -318,15 +318,23 @@ pub(crate) fn fit_modes(
         v[v.len() / 10].max(1e-300) * 0.3
     };
     let n_eff = problem.bins.len() as f64 / input.enbw_bins.max(1.0);
+    // The direct term's start: the level at the low end of the range (where a mode's
+    // acceleration response has fallen off), either sign, or none.
+    let direct = {
+        let k = problem.bins[0];
+        (input.psd[k] / problem.norm(f[k])).sqrt()
+    };
     let run = |seeds: &[Seed]| -> Option<(FitResult, usize)> {
         let m = seeds.len();
         let patterns = if m <= 4 { 1usize << (m - 1) } else { 1 };
         let mut best: Option<(FitResult, usize)> = None;
         for signs in 0..patterns {
-            let x0 = start(seeds, signs, floor);
-            if let Some(r) = problem.fit(&x0, m) {
-                if best.as_ref().is_none_or(|b| r.0.rss < b.0.rss) {
-                    best = Some(r);
+            for c in [direct, -direct, 0.0] {
+                let x0 = start(seeds, signs, floor, c);
+                if let Some(r) = problem.fit(&x0, m) {
+                    if best.as_ref().is_none_or(|b| r.0.rss < b.0.rss) {
+                        best = Some(r);
+                    }
                 }
             }
         }

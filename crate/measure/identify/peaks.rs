@@ -12,13 +12,19 @@ pub(super) struct Peak {
 /// Local maxima of the 7-bin-smoothed dB spectrum in bins `lo..=hi`, with their topographic
 /// prominence (height over the higher of the lowest points between it and a higher point on
 /// each side, or the band's end).
-pub(super) fn detect(psd: &Psd, lo: usize, hi: usize, min_db: f64, max_modes: usize) -> Vec<Peak> {
+pub(super) fn detect(
+    psd: &Psd,
+    lo: usize,
+    hi: usize,
+    min_db: f64,
+    max_modes: usize,
+    h: usize,
+) -> Vec<Peak> {
     let db: Vec<f64> = psd
         .psd
         .iter()
         .map(|p| 10.0 * p.max(1e-300).log10())
         .collect();
-    let h = 3usize;
     let sm: Vec<f64> = (lo..=hi)
         .map(|k| {
             let a = k.saturating_sub(h).max(lo);
