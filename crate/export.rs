@@ -1,5 +1,8 @@
 //! Exports of a shaper in the forms people paste into tools and controllers: CSV, JSON, a C
-//! array, and a RepRapFirmware `M593` line.
+//! array, and a RepRapFirmware `M593` line; [`firmware`]: per-axis configs for Klipper, Kalico,
+//! RepRapFirmware and Marlin.
+
+pub mod firmware;
 
 use crate::error::{Error, Result};
 use crate::shaper::Shaper;
@@ -186,14 +189,28 @@ fn gcode_number(x: f64) -> String {
 /// impulse except the first (strictly increasing). RRF 3.5 and earlier read `H` and `T`
 /// differently (T as durations between impulses); this line is not for them.
 ///
-/// Errors unless the shaper has at least two impulses, positive amplitudes summing to 1
-/// (within 1e-9) — which is what RRF can represent.
+/// Errors unless the shaper has at least two and at most
+/// [`firmware::RRF_MAX_IMPULSES`] impulses (RRF 3.6 AxisShaper.h `MaxImpulses`: `H` and `T`
+/// take at most 4 values), positive amplitudes summing to 1 (within 1e-9) — which is what RRF
+/// can represent. (RRF's `M593` code does not check the sign; negative amplitudes are refused
+/// here because its motion planner was not read for them.)
 pub fn to_rrf_m593(shaper: &Shaper) -> Result<String> {
     let imps = shaper.impulses();
     if imps.len() < 2 {
         return Err(Error::invalid(
             "impulses",
             "RRF's custom shaper needs at least two impulses",
+        ));
+    }
+    if imps.len() > firmware::RRF_MAX_IMPULSES {
+        return Err(Error::invalid(
+            "impulses",
+            format!(
+                "RepRapFirmware holds at most {} impulses (AxisShaper.h MaxImpulses), this \
+                 shaper has {}",
+                firmware::RRF_MAX_IMPULSES,
+                imps.len()
+            ),
         ));
     }
     if (shaper.amplitude_sum() - 1.0).abs() > 1e-9 {

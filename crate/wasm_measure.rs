@@ -556,3 +556,23 @@ pub fn draw_klipper_chart(
     })?;
     chart::draw_klipper_chart(&backend.into_drawing_area(), &chart, &style).map_err(js_error)
 }
+
+/// `firmwareConfig({ firmware, axes })` → `{ text, warnings }`: the config text of the shaper
+/// per axis for `firmware` — `"klipper"` (`[input_shaper]` block), `"klipperCommand"`
+/// (`SET_INPUT_SHAPER`), `"kalico"`, `"kalicoCommand"` (custom shapers too), `"rrf"`
+/// (RepRapFirmware 3.6 `M593`), `"marlin"` (ZV `M593`). `axes`: `[{ axis, family,
+/// frequencyHz, damping, impulses, maxAccel, modes }]` (see
+/// [`crate::export::firmware::AxisShaper`]). A shaper the firmware cannot express is an error
+/// naming the field and the firmware's limit. In the measured-data worker's module.
+#[cfg(feature = "js-recording")]
+#[wasm_bindgen(js_name = firmwareConfig)]
+pub fn firmware_config_js(request: JsValue) -> Result<JsValue, JsValue> {
+    use crate::export::firmware::{firmware_config, AxisShaper, Firmware};
+    #[derive(Deserialize)]
+    struct Request {
+        firmware: Firmware,
+        axes: Vec<AxisShaper>,
+    }
+    let r: Request = from_js(request, "request").map_err(js_error)?;
+    to_js(&firmware_config(r.firmware, &r.axes).map_err(js_error)?)
+}
