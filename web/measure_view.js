@@ -6,7 +6,7 @@
 // the table like calibrate_shaper's; below, the config text to copy; then the identified modes
 // with "Use these modes" and the spectrum they came from. A bad file leaves the last good result
 // on screen, its error (file, line, column) beside the drop zone.
-import initRecording, { drawKlipperChart } from '../pkg/page/recording.js';
+import initRecording, { drawKlipperChart, firmwareConfig } from '../pkg/page/recording.js';
 
 const $ = (id) => document.getElementById(id);
 /** Largest file accepted (a 10⁷-row Klipper file is ~350 MB). */
@@ -15,7 +15,6 @@ const MAX_FILE_BYTES = 512 * 1024 * 1024;
 const COLORS = ['#1f77b4', '#ff7f0e', '#2ca02c', '#d62728', '#9467bd', '#8c564b', '#e377c2', '#7f7f7f', '#bcbd22', '#17becf'];
 /** The crate's family names that Klipper's config spells otherwise. */
 const KLIPPER_NAME = { ei2: '2hump_ei', ei3: '3hump_ei' };
-const KLIPPER_TYPES = new Set(['zv', 'mzv', 'zvd', 'ei', '2hump_ei', '3hump_ei']);
 
 let worker = null;
 let hooks = null;
@@ -171,10 +170,10 @@ function show(data) {
   $('measure-modes-part').hidden = !id;
   if (id && r) {
     fillChannels(r.channels, id.channel);
-    status(`${FORMAT[r.format] ?? r.format}${r.rows ? `: ${r.rows.toLocaleString('en')} samples ` : ''}`
+    status(`${FORMAT[r.format] ?? r.format}${r.sampleRateHz ? `: ${r.rows.toLocaleString('en')} samples ` : ' '}`
       + `${r.sampleRateHz ? `at ${fmt(r.sampleRateHz, 6)} Hz over ${fmt(r.durationS, 4)} s` : ''}`
       + `${r.resampled ? ` (uneven time stamps, jitter ${pct(r.timing.jitter)}, resampled)` : ''}; channel ${id.channel}; `
-      + `Welch PSD with ${id.spectrum.segmentLength}-sample segments (${fmt(id.spectrum.resolutionHz, 3)} Hz bins, ${id.spectrum.segments} averaged)`
+      + `${id.spectrum.segmentLength ? `Welch PSD with ${id.spectrum.segmentLength}-sample segments (${fmt(id.spectrum.resolutionHz, 3)} Hz bins, ${id.spectrum.segments} averaged)` : `the file's spectrum (${fmt(id.spectrum.resolutionHz, 3)} Hz bins)`}`
       + `${id.freeDecay ? `; free decay found at ${fmt(id.freeDecay.startS, 3)}–${fmt(id.freeDecay.endS, 3)} s` : ''}.`);
     showModes(id);
     showRecommendation(data.recommendation);
@@ -264,38 +263,41 @@ function drawAxes() {
 
 // ---- config text -----------------------------------------------------------------------------
 
-function configText(format) {
+/** The config text of each axis's pick for `firmware` (firmwareConfig, crate/export/firmware.rs). */
+function configText(firmware) {
   const picks = (result?.axes ?? []).map((a) => ({ a, r: a.klipper?.rows?.[a.klipper.selected] })).filter((p) => p.r);
-  const lines = [];
-  const known = picks.filter(({ a }) => a.axis === 'x' || a.axis === 'y');
-  for (const { a } of picks.filter((p) => !known.includes(p))) {
-    lines.push(`# ${a.axis}: not an X or Y axis (name the file resonances_x_….csv or …_y_…) — left out`);
-  }
-  const type = (r) => KLIPPER_NAME[r.name] ?? r.name;
-  const bad = known.filter(({ r }) => !KLIPPER_TYPES.has(type(r)));
-  for (const { a, r } of bad) lines.push(`# axis ${a.axis}: ${r.name} is not a shaper type Klipper has — left out`);
-  const ok = known.filter((p) => !bad.includes(p));
-  const damping = (r) => (Number.isFinite(r.damping) ? fmt(r.damping, 3) : '0.1');
-  if (format === 'command') {
-    if (ok.length) {
-      lines.push(`SET_INPUT_SHAPER ${ok.map(({ a, r }) => {
-        const A = a.axis.toUpperCase();
-        return `SHAPER_TYPE_${A}=${type(r)} SHAPER_FREQ_${A}=${fixed(r.freq, 1)} DAMPING_RATIO_${A}=${damping(r)}`;
-      }).join(' ')}`);
-    }
-  } else if (ok.length) {
-    lines.push('[input_shaper]');
-    for (const { a, r } of ok) {
-      lines.push(`shaper_type_${a.axis}: ${type(r)}`, `shaper_freq_${a.axis}: ${fixed(r.freq, 1)}`, `damping_ratio_${a.axis}: ${damping(r)}`);
-    }
-    const limit = Math.min(...ok.map(({ r }) => r.maxAccel).filter(Number.isFinite));
-    if (Number.isFinite(limit)) lines.push(`# suggested max_accel (in [printer]): at most ${accel(limit)} mm/s² (the smaller over the axes)`);
-  }
-  return lines.join('\n');
+  const axes = picks.filter(({ a }) => /^[xyz]$/.test(a.axis));
+  const notes = picks.filter((p) => !axes.includes(p))
+    .map(({ a }) => `${a.axis}: not an X, Y or Z axis (Klipper names the files resonances_x_…, calibration_data_y_…): left out.`);
+  if (!axes.length) return { text: '', warnings: notes };
+  const out = firmwareConfig({
+    firmware,
+    axes: axes.map(({ a, r }) => ({
+      axis: a.axis,
+      family: KLIPPER_NAME[r.name] ?? r.name,
+      frequencyHz: Number(r.freq.toFixed(1)),
+      ...(Number.isFinite(r.damping) ? { damping: r.damping } : {}),
+      ...(r.shaper?.impulses ? { impulses: r.shaper.impulses } : {}),
+      ...(Number.isFinite(r.maxAccel) ? { maxAccel: r.maxAccel } : {}),
+      modes: (a.modes ?? []).map((m) => ({ frequencyHz: m.frequencyHz, damping: m.damping })),
+    })),
+  });
+  return { text: out.text, warnings: [...notes, ...out.warnings] };
 }
 
 function showConfig() {
-  $('measure-config-text').value = configText($('measure-config-format').value);
+  const box = $('measure-config-text');
+  try {
+    const { text, warnings } = configText($('measure-config-format').value);
+    box.value = text;
+    $('measure-config-error').textContent = '';
+    $('measure-config-notes').textContent = warnings.join(' ');
+  } catch (e) {
+    // A shaper the firmware cannot express: said, never a truncated line.
+    box.value = '';
+    $('measure-config-notes').textContent = '';
+    $('measure-config-error').textContent = e?.message ?? String(e);
+  }
 }
 
 // ---- identified modes (raw recordings) -------------------------------------------------------

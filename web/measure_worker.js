@@ -163,19 +163,36 @@ function shaperCurve(impulses, f) {
   });
 }
 
-/** One row of Klipper's table from a ranked candidate. */
+/** `values` at `bins`, read at the frequencies `f` (linear between bins, the end values beyond). */
+function onBins(values, bins, f) {
+  if (!bins || bins.length !== values.length || (bins.length === f.length && bins.every((b, i) => b === f[i]))) return values;
+  let j = 0;
+  return Float64Array.from(f, (x) => {
+    while (j < bins.length - 1 && bins[j + 1] < x) j++;
+    if (x <= bins[0]) return values[0];
+    if (j >= bins.length - 1) return values[bins.length - 1];
+    const t = (x - bins[j]) / (bins[j + 1] - bins[j]);
+    return values[j] + Math.min(1, Math.max(0, t)) * (values[j + 1] - values[j]);
+  });
+}
+
+/** One row of Klipper's table from a ranked candidate (or a family's fit, `{ name, pick, vals }`). */
 function row(c, f) {
-  const values = c.values ?? c.vals ?? (c.shaper?.impulses ? shaperCurve(c.shaper.impulses, f) : null);
+  const p = c.pick ?? c;
+  const given = c.values ?? c.vals;
+  const values = given ? onBins(given, c.freqBins ?? c.frequencyHz, f)
+    : c.shaper?.impulses ? shaperCurve(c.shaper.impulses, f) : null;
   return {
     label: c.label ?? c.name ?? c.family,
     name: c.name ?? c.family,
-    freq: c.frequencyHz ?? c.freq ?? c.spec?.frequencyHz ?? c.modes?.[0]?.frequencyHz ?? NaN,
-    damping: c.dampingRatio ?? c.damping ?? c.spec?.damping ?? c.modes?.[0]?.damping ?? NaN,
-    vibrations: c.vibrations ?? c.vibrs ?? c.remainingVibration,
-    smoothing: c.smoothing,
-    maxAccel: c.maxAccel,
-    score: c.score ?? c.klipperScore,
-    values: values ? Float64Array.from(values) : null,
+    kind: c.kind ?? c.firmware ?? null,
+    freq: p.freq ?? p.frequencyHz ?? c.spec?.frequencyHz ?? c.modes?.[0]?.frequencyHz ?? NaN,
+    damping: p.dampingRatio ?? c.dampingRatio ?? c.damping ?? c.spec?.damping ?? NaN,
+    vibrations: p.vibrations ?? p.vibrs ?? c.remainingVibration,
+    smoothing: p.smoothing,
+    maxAccel: p.maxAccel,
+    score: p.score ?? c.klipperScore,
+    values: values?.length === f.length ? Float64Array.from(values) : null,
     shaper: c.shaper ?? null,
   };
 }
@@ -195,7 +212,7 @@ function rankAxis(axis, spectrum, modes, channel) {
   const out = { axis, spectrum, channel, klipper: null, optimal: null, error: null };
   try {
     const rec = recommendShaper(input, at, { criterion: 'klipper' });
-    out.klipper = { rows: rec.ranked.map((c) => row(c, f)), selected: rec.recommended };
+    out.klipper = { rows: (rec.ranked ?? rec.families).map((c) => row(c, f)), selected: rec.recommended ?? rec.best };
   } catch (e) {
     out.error = e?.message ?? String(e);
   }
@@ -219,8 +236,9 @@ function klipperAxes(files, options, modes, modesFile) {
   }
   return [...groups].map(([axis, list]) => {
     const spectrum = combine(list.map(({ name, rec }) => klipperSpectrum(name, rec)));
-    const ranked = rankAxis(axis, spectrum, list.some(({ name }) => name === modesFile) ? modes : null, options.psdChannel ?? 'sum');
-    return { ...ranked, files: list.map((x) => x.name), formats: list.map((x) => x.rec.format) };
+    const own = list.some(({ name }) => name === modesFile) ? modes : null;
+    const ranked = rankAxis(axis, spectrum, own, options.psdChannel ?? 'sum');
+    return { ...ranked, files: list.map((x) => x.name), formats: list.map((x) => x.rec.format), modes: own ?? [] };
   });
 }
 

@@ -73,8 +73,13 @@ test('a raw Klipper recording: the axis chart, Klipper\'s table and the config',
   const config = await page.inputValue('#measure-config-text');
   const best = rows.find((r) => r.best);
   assert.match(config, new RegExp(`^\\[input_shaper\\]\\nshaper_type_x: ${best.family}\\nshaper_freq_x: ${best.frequency.toFixed(1)}\\n`), config);
-  await page.selectOption('#measure-config-format', 'command');
-  assert.match(await page.inputValue('#measure-config-text'), /^SET_INPUT_SHAPER SHAPER_TYPE_X=\S+ SHAPER_FREQ_X=[\d.]+ DAMPING_RATIO_X=[\d.]+$/);
+  assert.match(config, /# in \[printer\]: max_accel: \d+00\n/, config);
+  await page.selectOption('#measure-config-format', 'klipperCommand');
+  assert.equal(await page.inputValue('#measure-config-text'),
+    `SET_INPUT_SHAPER SHAPER_TYPE_X=${best.family} SHAPER_FREQ_X=${best.frequency.toFixed(1)} DAMPING_RATIO_X=0.1\n`);
+  // A firmware that cannot run the pick says so beside the (empty) text, or writes it with a note.
+  await page.selectOption('#measure-config-format', 'marlin');
+  assert.match(await page.inputValue('#measure-config-text'), /^; x: Marlin runs ZV only/);
   // The raw recording's modes are identified, for the playground.
   await page.waitForSelector('#measure-modes tbody tr[data-mode]');
   assert.equal(await page.isDisabled('#measure-accept'), false);
