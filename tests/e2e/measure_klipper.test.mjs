@@ -34,7 +34,7 @@ async function drop(page, names, axes) {
 /** The table of an axis as shown: [{ family, frequency, best }]. */
 function table(page, axis) {
   return page.$$eval(`.measure-axis[data-axis="${axis}"] table.klipper-table tbody tr`, (rows) => rows.map((r) => ({
-    family: r.dataset.family, frequency: Number(r.dataset.frequency), shown: r.cells[3].textContent, best: r.classList.contains('best'),
+    family: r.dataset.family, frequency: Number(r.dataset.frequency), shown: r.cells[2].textContent, best: r.classList.contains('best'),
   })));
 }
 
