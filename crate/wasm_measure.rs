@@ -11,10 +11,12 @@
 use crate::canvas::Canvas;
 use crate::chart::{self, ChartStyle};
 use crate::error::Error;
-use crate::measure::identify::{identify, IdentifyOptions};
+use crate::measure::identify::{identify, identify_spectrum, IdentifyOptions};
 use crate::measure::psd::{fft_spectrum, welch, FftOptions, Psd, WelchOptions};
 use crate::measure::recommend::{recommend, MeasuredMode, MeasuredSpectrum, RecommendOptions};
+use crate::measure::recording::Parsed;
 use crate::measure::recording::{self, Recording, RecordingError, RecordingOptions};
+use crate::measure::spectrum_file::{Normalization, SpectrumFile};
 use crate::wasm::{from_js, js_error, set, to_js};
 use plotters::prelude::*;
 use serde::Deserialize;
@@ -24,7 +26,7 @@ use web_sys::HtmlCanvasElement;
 
 /// A recording error as a JS `Error` with `line`, `column`, `columnName`.
 fn recording_error(e: RecordingError) -> JsValue {
-    let (line, column, name) = (e.line, e.column, e.column_name.clone());
+    let (line, column, name, file) = (e.line, e.column, e.column_name.clone(), e.file.clone());
     let js = js_error(Error::from(e));
     if let Some(obj) = js.dyn_ref::<js_sys::Object>() {
         let _ = js_sys::Reflect::set(obj, &"line".into(), &(line as f64).into());
@@ -33,6 +35,9 @@ fn recording_error(e: RecordingError) -> JsValue {
         }
         if let Some(n) = name {
             let _ = js_sys::Reflect::set(obj, &"columnName".into(), &n.into());
+        }
+        if let Some(f) = file {
+            let _ = js_sys::Reflect::set(obj, &"file".into(), &f.into());
         }
     }
     js
@@ -109,6 +114,93 @@ fn recording_to_js(rec: &Recording) -> Result<JsValue, JsValue> {
     Ok(out.into())
 }
 
+fn channels_to_js(list: &[recording::Channel]) -> Result<js_sys::Array, JsValue> {
+    let out = js_sys::Array::new();
+    for c in list {
+        let ch = js_sys::Object::new();
+        set(&ch, "name", &c.name.clone().into())?;
+        set(
+            &ch,
+            "values",
+            &js_sys::Float64Array::from(c.values.as_slice()),
+        )?;
+        out.push(&ch);
+    }
+    Ok(out)
+}
+
+/// A Klipper spectrum file as the JS object `parseRecording` returns for it.
+fn spectrum_to_js(s: &SpectrumFile) -> Result<JsValue, JsValue> {
+    let out = js_sys::Object::new();
+    let arr = |v: &[f64]| js_sys::Float64Array::from(v);
+    set(&out, "format", &to_js(&s.format)?)?;
+    set(&out, "fileName", &to_js(&s.file_name)?)?;
+    set(&out, "axis", &to_js(&s.axis)?)?;
+    set(&out, "frequencyHz", &arr(&s.frequency_hz))?;
+    set(&out, "psdX", &arr(&s.psd_x))?;
+    set(&out, "psdY", &arr(&s.psd_y))?;
+    set(&out, "psdZ", &arr(&s.psd_z))?;
+    set(&out, "psdSum", &arr(&s.psd_sum))?;
+    set(&out, "psd", &arr(&s.psd))?;
+    set(&out, "channel", &to_js(&s.channel)?)?;
+    set(&out, "normalization", &to_js(&s.normalization)?)?;
+    set(&out, "resolutionHz", &s.resolution_hz.into())?;
+    set(&out, "even", &s.even.into())?;
+    set(&out, "rows", &(s.frequency_hz.len() as f64).into())?;
+    set(&out, "sources", &(s.sources as f64).into())?;
+    let shapers = js_sys::Array::new();
+    for sh in &s.shapers {
+        let o = js_sys::Object::new();
+        set(&o, "name", &sh.name.clone().into())?;
+        set(&o, "frequencyHz", &sh.frequency_hz.into())?;
+        set(&o, "values", &arr(&sh.values))?;
+        shapers.push(&o);
+    }
+    set(&out, "shapers", &shapers)?;
+    set(&out, "extra", &channels_to_js(&s.extra)?.into())?;
+    set(&out, "runs", &channels_to_js(&s.runs)?.into())?;
+    Ok(out.into())
+}
+
+fn parsed_to_js(p: &Parsed) -> Result<JsValue, JsValue> {
+    match p {
+        Parsed::Recording(r) => recording_to_js(r),
+        Parsed::Spectrum(s) => spectrum_to_js(s),
+    }
+}
+
+/// A spectrum object from JS (`{ frequencyHz, psd, normalization? }`) as a [`SpectrumFile`].
+fn spectrum_from_js(value: &JsValue) -> Result<SpectrumFile, Error> {
+    let frequency_hz = f64_vec(&get(value, "frequencyHz"), "spectrum.frequencyHz")?;
+    let psd = f64_vec(&get(value, "psd"), "spectrum.psd")?;
+    let normalization: Normalization = match get(value, "normalization") {
+        v if v.is_undefined() || v.is_null() => Normalization::None,
+        v => from_js(v, "spectrum.normalization")?,
+    };
+    let segment_length = get(value, "segmentLength").as_f64().map(|v| v as usize);
+    let (resolution_hz, even) = crate::measure::spectrum_file::resolution_of(&frequency_hz);
+    Ok(SpectrumFile {
+        format: recording::RecordingFormat::KlipperResonances,
+        file_name: get(value, "fileName").as_string(),
+        axis: get(value, "axis").as_string(),
+        psd_sum: psd.clone(),
+        psd,
+        psd_x: Vec::new(),
+        psd_y: Vec::new(),
+        psd_z: Vec::new(),
+        frequency_hz,
+        channel: Default::default(),
+        normalization,
+        resolution_hz,
+        even,
+        shapers: Vec::new(),
+        extra: Vec::new(),
+        runs: Vec::new(),
+        sources: 1,
+        segment_length,
+    })
+}
+
 fn psd_to_js(psd: &Psd) -> Result<JsValue, JsValue> {
     let out = js_sys::Object::new();
     set(
@@ -126,16 +218,21 @@ fn psd_to_js(psd: &Psd) -> Result<JsValue, JsValue> {
     Ok(out.into())
 }
 
-/// `parseRecording(text, { timeColumn?, timeScale? })` → `{ format: 'klipper' | 'csv',
-/// timeColumn, sampleRateHz, startTimeS, durationS, rows, resampled, timing: { meanStepS,
-/// minStepS, maxStepS, jitter }, channels: [{ name, values: Float64Array }] }`. Errors carry
-/// `line`, `column`, `columnName`.
+/// `parseRecording(text, { timeColumn?, timeScale?, fileName?, channel? })` → for a recording
+/// `{ format: 'klipper' | 'csv', timeColumn, sampleRateHz, startTimeS, durationS, rows,
+/// resampled, timing: { meanStepS, minStepS, maxStepS, jitter }, channels: [{ name, values:
+/// Float64Array }] }`; for a Klipper spectrum file `{ format: 'klipperResonances' |
+/// 'klipperCalibration', fileName, axis: 'x' | 'y' | 'z' | null, frequencyHz, psdX, psdY, psdZ,
+/// psdSum, psd (Float64Arrays; psd is the chosen channel: 'x' | 'y' | 'z' | 'sum', default
+/// 'sum'), channel, normalization: 'none' | 'klipper', resolutionHz, even, rows, sources,
+/// shapers: [{ name, frequencyHz, values }], extra: [{ name, values }], runs: [{ name, values }]
+/// }`. Errors carry `line`, `column`, `columnName` and `file` (the `fileName` option).
 #[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = parseRecording)]
 pub fn parse_recording(text: &str, options: JsValue) -> Result<JsValue, JsValue> {
     let options: RecordingOptions = self::options(options, "options").map_err(js_error)?;
-    let rec = recording::parse_recording(text, &options).map_err(recording_error)?;
-    recording_to_js(&rec)
+    let parsed = recording::parse_file(text, &options).map_err(recording_error)?;
+    parsed_to_js(&parsed)
 }
 
 /// `new RecordingParser({ timeColumn?, timeScale? })`: reads a recording in chunks —
@@ -188,8 +285,8 @@ impl JsRecordingParser {
             .inner
             .take()
             .ok_or_else(|| js_error(Error::invalid("recording", "finish() was already called")))?;
-        let rec = p.finish().map_err(recording_error)?;
-        recording_to_js(&rec)
+        let parsed = p.finish_any().map_err(recording_error)?;
+        parsed_to_js(&parsed)
     }
 }
 
@@ -291,7 +388,10 @@ mod serde_json_like {
     }
 }
 
-/// `identifyModes(recording, options)`: `recording` is what `parseRecording` returns (then
+/// `identifyModes(recording, options)`: `recording` is a spectrum (`{ frequencyHz, psd,
+/// normalization?: 'none' | 'klipper', segmentLength? }`, e.g. what `parseRecording` returns for
+/// a Klipper spectrum file: the modes are then fitted to its bins, see `identify_spectrum`), or
+/// what `parseRecording` returns for a recording (then
 /// `options.channel` picks a channel by name or index, default the first) or a plain signal
 /// (`Float64Array` / number array, then `options.sampleRateHz` is required). Options as
 /// `IdentifyOptions`: `{ sampleRateHz?, signal: 'acceleration' | 'velocity' | 'position',
@@ -302,6 +402,33 @@ mod serde_json_like {
 #[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = identifyModes)]
 pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+    let is_spectrum = recording.is_object()
+        && !get(&recording, "frequencyHz").is_undefined()
+        && !get(&recording, "psd").is_undefined();
+    if is_spectrum {
+        let spectrum = spectrum_from_js(&recording).map_err(js_error)?;
+        let opts: IdentifyOptions = {
+            let copy = js_sys::Object::new();
+            if options.is_object() {
+                let _ = js_sys::Object::assign(&copy, options.unchecked_ref());
+                let _ = js_sys::Reflect::delete_property(&copy, &"channel".into());
+            }
+            from_js(copy.into(), "options").map_err(js_error)?
+        };
+        let id = identify_spectrum(&spectrum, &opts).map_err(js_error)?;
+        let out = js_sys::Object::new();
+        set(&out, "channel", &get(&recording, "channel"))?;
+        set(&out, "modes", &to_js(&id.modes)?)?;
+        set(&out, "spectrum", &psd_to_js(&id.spectrum)?)?;
+        set(
+            &out,
+            "detectionSegmentLength",
+            &(id.detection_segment_length as f64).into(),
+        )?;
+        set(&out, "bandHz", &to_js(&id.band_hz)?)?;
+        set(&out, "freeDecay", &JsValue::NULL)?;
+        return Ok(out.into());
+    }
     let is_signal = recording.is_instance_of::<js_sys::Float64Array>()
         || recording.is_instance_of::<js_sys::Float32Array>()
         || js_sys::Array::is_array(&recording);

@@ -192,6 +192,10 @@ pub fn axis_from_file_name(name: &str) -> Option<String> {
 
 /// Least-squares bin spacing of `f` over the row index, and whether the rows are even to within
 /// the 0.05 Hz of `%.1f` rounding (and 0.1 % of a bin).
+pub fn resolution_of(f: &[f64]) -> (f64, bool) {
+    resolution(f)
+}
+
 pub(crate) fn resolution(f: &[f64]) -> (f64, bool) {
     let n = f.len();
     if n < 2 {

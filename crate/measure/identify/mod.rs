@@ -12,12 +12,14 @@
 //!    averaged over a tenth of the peak's width so the bins' noise does not move the crossings —
 //!    falls to half the peak give ζ ≈ (f₂ − f₁)/(2f_p). The natural frequency is f_p·√(1−2ζ²) for a
 //!    position signal, f_p for velocity, f_p/√(1−2ζ²) for acceleration (where each |H|² peaks).
-//! 3. **Spectrum fit** (frequency domain, refines 2). The PSD around the peaks is fitted, in
-//!    log, by the power spectrum of a modal sum driven by white noise,
-//!    S(f) = |Σᵢ gᵢ (ω/ωᵢ)^p ωᵢ² / (ωᵢ² − ω² + 2iζᵢωᵢω)|² + B, p = 2, 1, 0 for acceleration,
-//!    velocity, position (real, signed modal gains gᵢ: classically damped modes), convolved
-//!    with the window's spectral kernel |W(ν)|² where peaks are narrow, so leakage does not
-//!    widen them. Levenberg–Marquardt; every sign pattern of the gains is tried.
+//! 3. **Spectrum fit** (frequency domain, refines 2): all modes fitted jointly to the PSD by
+//!    the expected Welch estimate of a modal response to a smooth excitation — coherent modal
+//!    sum with a direct term, excitation (f/f_ref)^a with a fitted, white floor, convolved with
+//!    the window's kernel, Klipper's normalisation when a file has it — in log by
+//!    Levenberg–Marquardt, with modes hidden on a neighbour's flank added from the residuals by
+//!    an information criterion (identify/model.rs has the details). The older per-peak fit
+//!    (identify/spectrum_fit.rs: white-noise excitation, kernel only near narrow peaks) is the
+//!    fallback when the joint fit fails.
 //! 4. **Free decay** (time domain). If the recording rings down after a hit (a block of two
 //!    periods at least 20 dB above the median block, less than half of it two blocks earlier;
 //!    the decay ends where the blocks fall below twice the median), the ring-down is
@@ -310,7 +312,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
             count("segmentLength", s, 64, n)?;
             s
         }
-        None => pow2_floor(n / 8).clamp(64, 65536),
+        None => pow2_floor(n / 4).clamp(64, 65536),
     };
     let detect_options = WelchOptions {
         sample_rate_hz: fs,
@@ -326,7 +328,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
     let df0 = psd0.resolution_hz;
     let f_lo = match options.min_frequency_hz {
         Some(f) => positive("minFrequencyHz", f)?,
-        None => 4.0 * df0,
+        None => 3.0 * df0,
     };
     let f_hi = match options.max_frequency_hz {
         Some(f) => positive("maxFrequencyHz", f)?,
@@ -368,11 +370,15 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
     if peaks.is_empty() {
         return Ok(result);
     }
-    // Longer segments until the narrowest peak spans ≥ 12 bins (at least 4 segments kept).
+    // Segments from the record and the peaks: the narrowest half-power width should span 4 to
+    // 8 bins (the fit models the window's smearing, so a few bins suffice, and shorter
+    // segments average more of them: a sweep's PSD is then steadier). Longer while it spans
+    // fewer (up to n/4), or once shorter when it spans more (down to 64 samples).
     let n_max = pow2_floor(n / 4).max(n0).min(1 << 20);
     let mut psd = psd0;
     let mut widths: Vec<Option<HalfPower>>;
     let mut seg = n0;
+    let mut shrunk = false;
     loop {
         let (lo, hi) = (bin(&psd, f_lo).max(1), bin(&psd, f_hi));
         widths = peaks
@@ -409,11 +415,19 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
             .flatten()
             .map(|h| h.width_hz / psd.resolution_hz)
             .fold(f64::INFINITY, f64::min);
-        if !narrowest.is_finite() || narrowest >= 12.0 || seg >= n_max {
+        if !narrowest.is_finite() {
             break;
         }
-        let factor = (16.0 / narrowest).ceil() as usize;
-        seg = (seg * factor.next_power_of_two()).min(n_max);
+        if narrowest > 8.0 && !shrunk && seg > 64 {
+            shrunk = true;
+            let factor = pow2_floor((narrowest / 4.0).floor() as usize).max(1);
+            seg = (seg / factor).max(64);
+        } else if narrowest < 4.0 && !shrunk && seg < n_max {
+            let factor = (8.0 / narrowest).ceil() as usize;
+            seg = (seg * factor.next_power_of_two()).min(n_max);
+        } else {
+            break;
+        }
         psd = welch(
             signal,
             &WelchOptions {
@@ -524,7 +538,8 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
 
 /// Identifies the modes in a spectrum alone (a Klipper spectrum file, or a raw file's Klipper
 /// spectrum): the peaks of `spectrum.psd` (3-bin smoothing: Klipper's bins are coarse) seed the
-/// joint fit of [`model`], which models Klipper's Welch window (symmetric Kaiser β = 6) and,
+/// joint fit of the module docs' step 3 (identify/model.rs), which models Klipper's Welch
+/// window (symmetric Kaiser β = 6) and,
 /// when `spectrum.normalization` says so, its normalisation (fitted above 10 Hz only, where the
 /// released and the current Klipper agree: psd/(f + 0.1)). `options.sampleRateHz` is not used;
 /// the band defaults to [5 Hz or the second bin, the last bin].
@@ -558,7 +573,7 @@ pub fn identify_spectrum(
             format!("must be a finite number ≥ 0, got {}", p[i]),
         ));
     }
-    if let Some(i) = f.windows(2).position(|w| !(w[1] > w[0])) {
+    if let Some(i) = f.windows(2).position(|w| w[1] <= w[0] || w[1].is_nan()) {
         return Err(Error::invalid(
             format!("spectrum.frequencyHz[{}]", i + 1),
             "frequencies must increase",

@@ -108,8 +108,19 @@ fn kernel(spec: WindowSpec, q: usize) -> Vec<f64> {
 }
 
 /// The model without kernel and normalisation at frequency f: E(f)|c + ΣgH|².
-fn response(x: &[f64], m: usize, power: i32, f_ref: f64, f: f64) -> f64 {
+fn response(x: &[f64], m: usize, power: i32, f_ref: f64, edges: Edges, f: f64) -> f64 {
     let f = f.abs().max(1e-9);
+    let mut band = 1.0;
+    if edges.any() {
+        let w = x[x.len() - 1].exp();
+        let logistic = |t: f64| 1.0 / (1.0 + (-t).exp());
+        if edges.low {
+            band *= logistic((f - x[3 * m + 3]) / w);
+        }
+        if edges.high {
+            band *= logistic((x[3 * m + 3 + usize::from(edges.low)] - f) / w);
+        }
+    }
     let mut h = Complex::new(x[3 * m], 0.0);
     for i in 0..m {
         let fi = x[3 * i].exp();
@@ -119,7 +130,25 @@ fn response(x: &[f64], m: usize, power: i32, f_ref: f64, f: f64) -> f64 {
         let num = g * (f / fi).powi(power) * fi * fi / den.norm_sqr();
         h = h + den.conj() * num;
     }
-    (x[3 * m + 1] * (f / f_ref).ln()).exp() * h.norm_sqr()
+    band * (x[3 * m + 1] * (f / f_ref).ln()).exp() * h.norm_sqr()
+}
+
+/// The swept band's edges inside the fitted range, when the PSD shows them (a narrow sweep):
+/// E(f) is then multiplied by logistic steps at f_lo and f_hi of a common width w, all three
+/// fitted (parameters after ln B: f_lo, f_hi, ln w, those present).
+#[derive(Debug, Clone, Copy, Default)]
+struct Edges {
+    low: bool,
+    high: bool,
+}
+
+impl Edges {
+    fn any(self) -> bool {
+        self.low || self.high
+    }
+    fn count(self) -> usize {
+        usize::from(self.low) + usize::from(self.high) + usize::from(self.any())
+    }
 }
 
 struct Problem<'a> {
@@ -128,6 +157,7 @@ struct Problem<'a> {
     logs: Vec<f64>,
     f_ref: f64,
     power: i32,
+    edges: Edges,
 }
 
 impl Problem<'_> {
@@ -139,7 +169,9 @@ impl Problem<'_> {
         if kern.is_empty() {
             for &k in &self.bins {
                 let f = inp.frequency_hz[k];
-                out.push(self.norm(f) * (response(x, m, self.power, self.f_ref, f) + floor));
+                out.push(
+                    self.norm(f) * (response(x, m, self.power, self.f_ref, self.edges, f) + floor),
+                );
             }
         } else {
             let df = inp.resolution_hz;
@@ -151,7 +183,7 @@ impl Problem<'_> {
             let fine: Vec<f64> = (0..count)
                 .map(|t| {
                     let f = f0 + (grid0 + t as f64) * df / q as f64;
-                    response(x, m, self.power, self.f_ref, f)
+                    response(x, m, self.power, self.f_ref, self.edges, f)
                 })
                 .collect();
             for &k in &self.bins {
@@ -203,9 +235,11 @@ impl Problem<'_> {
             let scale = (0..m)
                 .map(|i| start[3 * i + 2].abs())
                 .fold(1e-300, f64::max);
-            let steps: Vec<f64> = (0..3 * m + 3)
+            let steps: Vec<f64> = (0..3 * m + 3 + self.edges.count())
                 .map(|i| {
-                    if i < 3 * m {
+                    if i >= 3 * m + 3 {
+                        1e-6 * start[i].abs().max(1e-3)
+                    } else if i < 3 * m {
                         match i % 3 {
                             0 => 1e-7,
                             1 => 1e-5,
@@ -247,7 +281,14 @@ fn bic(fit: &FitResult, n_eff: f64) -> f64 {
 }
 
 /// Initial parameters from seeds, with gain signs from `signs` (bit i−1 flips mode i).
-fn start(seeds: &[Seed], signs: usize, floor: f64, direct: f64) -> Vec<f64> {
+fn start(
+    seeds: &[Seed],
+    signs: usize,
+    floor: f64,
+    direct: f64,
+    exponent: f64,
+    edges: &[f64],
+) -> Vec<f64> {
     let mut x = Vec::with_capacity(3 * seeds.len() + 3);
     for (i, s) in seeds.iter().enumerate() {
         let sign = if i > 0 && (signs >> (i - 1)) & 1 == 1 {
@@ -261,8 +302,9 @@ fn start(seeds: &[Seed], signs: usize, floor: f64, direct: f64) -> Vec<f64> {
         x.push(sign * (s.peak_psd - floor).max(floor).sqrt() * 2.0 * z);
     }
     x.push(direct); // c
-    x.push(0.0); // a
+    x.push(exponent); // a
     x.push(floor.max(1e-300).ln());
+    x.extend_from_slice(edges);
     x
 }
 
@@ -301,11 +343,64 @@ pub(crate) fn fit_modes(
         return None;
     }
     // With the kernel the bins must be contiguous (the fine grid spans them).
+    // Band edges: going out from the outermost seeds, a fall of more than 12 dB from one bin
+    // to the next that does not come back (a mode's flank, smoothed by the window, is gentler).
+    let unnorm = |k: usize| {
+        input.psd[k]
+            * if input.klipper_normalized {
+                f[k] + 0.1
+            } else {
+                1.0
+            }
+    };
+    let drop = |a: usize, b: usize| 10.0 * (unnorm(b).max(1e-300) / unnorm(a).max(1e-300)).log10();
+    let (k_lo, k_hi) = (bins[0], bins[bins.len() - 1]);
+    let seed_lo = seeds
+        .iter()
+        .map(|s| s.frequency_hz)
+        .fold(f64::INFINITY, f64::min);
+    let seed_hi = seeds.iter().map(|s| s.frequency_hz).fold(0.0, f64::max);
+    let mut edge_hi = None;
+    for k in k_lo + 1..k_hi {
+        if f[k - 1] > seed_hi && drop(k - 1, k) < -12.0 && drop(k, k + 1) < 3.0 {
+            edge_hi = Some(f[k - 1] + 0.5 * df);
+            break;
+        }
+    }
+    let mut edge_lo = None;
+    for k in (k_lo + 1..k_hi).rev() {
+        if f[k + 1] < seed_lo && drop(k + 1, k) < -12.0 && drop(k, k - 1) < 3.0 {
+            edge_lo = Some(f[k + 1] - 0.5 * df);
+            break;
+        }
+    }
+    // Inside a swept band's edges the excitation is smooth; at them it is not (and the
+    // window smears them over ±2 bins): the fit keeps to the bins 2.5 bins inside.
+    let bins: Vec<usize> = bins
+        .into_iter()
+        .filter(|&k| {
+            edge_lo.is_none_or(|e| f[k] >= e + 2.0 * df)
+                && edge_hi.is_none_or(|e| f[k] <= e - 2.0 * df)
+        })
+        .collect();
+    if bins.len() < 3 * seeds.len() + 6 {
+        return None;
+    }
+    let (edge_lo, edge_hi): (Option<f64>, Option<f64>) = (None, None);
+    let edges = Edges {
+        low: edge_lo.is_some(),
+        high: edge_hi.is_some(),
+    };
+    let mut edge_start: Vec<f64> = edge_lo.into_iter().chain(edge_hi).collect();
+    if edges.any() {
+        edge_start.push((0.5 * df).ln());
+    }
     let problem = Problem {
         input,
         logs: bins.iter().map(|&k| input.psd[k].ln()).collect(),
         f_ref: (lo * hi).sqrt(),
         power: input.kind.power(),
+        edges,
         bins,
     };
     let floor = {
@@ -329,11 +424,17 @@ pub(crate) fn fit_modes(
         let patterns = if m <= 4 { 1usize << (m - 1) } else { 1 };
         let mut best: Option<(FitResult, usize)> = None;
         for signs in 0..patterns {
-            for c in [direct, -direct, 0.0] {
-                let x0 = start(seeds, signs, floor, c);
-                if let Some(r) = problem.fit(&x0, m) {
-                    if best.as_ref().is_none_or(|b| r.0.rss < b.0.rss) {
-                        best = Some(r);
+            // Starts: white (a = 0) or swept (a = 2: Klipper's acceleration ∝ f at constant
+            // Hz/s) excitation; the direct term of either sign (its level from the low end of
+            // the range under that excitation) or none.
+            for a in [0.0, 2.0] {
+                let c0 = direct / (f[problem.bins[0]] / problem.f_ref).powf(0.5 * a);
+                for c in [c0, -c0, 0.0] {
+                    let x0 = start(seeds, signs, floor, c, a, &edge_start);
+                    if let Some(r) = problem.fit(&x0, m) {
+                        if best.as_ref().is_none_or(|b| r.0.rss < b.0.rss) {
+                            best = Some(r);
+                        }
                     }
                 }
             }
@@ -398,7 +499,25 @@ pub(crate) fn fit_modes(
         let Some(candidate) = run(&trial) else {
             break;
         };
-        if bic(&candidate.0, n_eff) < bic(&best.0, n_eff) - 10.0 {
+        let new = &candidate.0.x;
+        let k = trial.len() - 1;
+        let stands = {
+            let fi = new[3 * k].exp();
+            let mut without = new.clone();
+            without[3 * k + 2] = 0.0;
+            let at = |x: &[f64]| {
+                response(
+                    x,
+                    trial.len(),
+                    problem.power,
+                    problem.f_ref,
+                    problem.edges,
+                    fi,
+                ) + x[3 * trial.len() + 2].exp()
+            };
+            10.0 * (at(new) / at(&without).max(1e-300)).log10() >= 3.0 && new[3 * k + 1].exp() < 0.3
+        };
+        if stands && bic(&candidate.0, n_eff) < bic(&best.0, n_eff) - 10.0 {
             seeds = trial;
             best = candidate;
         } else {
@@ -425,8 +544,9 @@ pub(crate) fn fit_modes(
         // How far the mode stands over the model without it, at its frequency.
         let mut without = fit.x.clone();
         without[3 * i + 2] = 0.0;
-        let at =
-            |x: &[f64]| response(x, m, problem.power, problem.f_ref, fi) + fit.x[3 * m + 2].exp();
+        let at = |x: &[f64]| {
+            response(x, m, problem.power, problem.f_ref, problem.edges, fi) + fit.x[3 * m + 2].exp()
+        };
         let standing_db = 10.0 * (at(&fit.x) / at(&without).max(1e-300)).log10();
         let _ = &kern;
         out.push(FittedMode {
