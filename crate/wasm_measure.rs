@@ -13,7 +13,9 @@ use crate::chart::{self, ChartStyle};
 use crate::error::Error;
 use crate::measure::identify::{identify, identify_spectrum, IdentifyOptions};
 use crate::measure::psd::{fft_spectrum, welch, FftOptions, Psd, WelchOptions};
-use crate::measure::recommend::{recommend, MeasuredMode, MeasuredSpectrum, RecommendOptions};
+use crate::measure::recommend::{
+    recommend, MeasuredMode, MeasuredSpectrum, RecommendOptions, SpectrumRun,
+};
 use crate::measure::recording::Parsed;
 use crate::measure::recording::{self, Recording, RecordingError, RecordingOptions};
 use crate::measure::spectrum_file::{Normalization, SpectrumFile};
@@ -506,30 +508,85 @@ pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, J
     Ok(out.into())
 }
 
-/// `recommendShaper(spectrum, modes, options?)`: `spectrum = { frequencyHz, psd }` (arrays or
-/// `Float64Array`s, e.g. `identifyModes(…).spectrum`), `modes = [{ frequencyHz, damping,
-/// frequencyUncertaintyHz?, dampingUncertainty? }]` (e.g. `identifyModes(…).modes`), options
-/// `{ families?: [{ family, … }], criterion?: 'duration' | 'klipper', maxRemainingVibration?,
-/// scv?, uncertaintySigmas?, minFrequencyHz?, maxFrequencyHz? }` → `{ criterion, recommended,
-/// ranked: [{ label, family, spec, modes, shaper, durationS, remainingVibration,
-/// nominalRemainingVibration, smoothing, maxAccel, klipperScore, acceptable }], dampingTested,
-/// frequencyFactors, bandHz }`.
-#[cfg(feature = "js-playground")]
+/// `recommendShaper(spectrum, modes, options?)`: `spectrum = { frequencyHz, psd,
+/// normalization?: 'none' | 'klipper', channel?: 'sum' | 'x' | 'y' | 'z', psdX?, psdY?, psdZ?,
+/// psdSum?, runs?: [{ name, values }] }` (arrays or `Float64Array`s, e.g.
+/// `identifyModes(…).spectrum` or a parsed Klipper spectrum file), `modes = [{ frequencyHz,
+/// damping, frequencyUncertaintyHz?, dampingUncertainty? }]` (e.g. `identifyModes(…).modes`;
+/// not used by `criterion: 'klipper'`), options `{ families?: [{ family, … }], criterion?:
+/// 'duration' | 'klipper', maxRemainingVibration?, scv?, uncertaintySigmas?, minFrequencyHz?,
+/// maxFrequencyHz?, shapers?, dampingRatio?, maxSmoothing?, maxVibrations?,
+/// testDampingRatios?, shaperFrequencies?, shaperFrequencyRange?: { start?, end?, step? } }` →
+/// `{ criterion, recommended, ranked: [{ label, family, spec, modes, shaper, durationS,
+/// remainingVibration, nominalRemainingVibration, smoothing, maxAccel, klipperScore,
+/// acceptable }], dampingTested, frequencyFactors, bandHz, klipper? }` (`klipper`: Klipper's
+/// table, see crate::measure::recommend). In the measured-data worker's module (js-recording).
+#[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = recommendShaper)]
 pub fn recommend_shaper(
     spectrum: JsValue,
     modes: JsValue,
     options: JsValue,
 ) -> Result<JsValue, JsValue> {
-    let spectrum = MeasuredSpectrum {
-        frequency_hz: f64_vec(&get(&spectrum, "frequencyHz"), "spectrum.frequencyHz")
-            .map_err(js_error)?,
-        psd: f64_vec(&get(&spectrum, "psd"), "spectrum.psd").map_err(js_error)?,
+    let spectrum = measured_spectrum(&spectrum).map_err(js_error)?;
+    let modes: Vec<MeasuredMode> = if modes.is_undefined() || modes.is_null() {
+        Vec::new()
+    } else {
+        from_js(modes, "modes").map_err(js_error)?
     };
-    let modes: Vec<MeasuredMode> = from_js(modes, "modes").map_err(js_error)?;
     let options: RecommendOptions = self::options(options, "options").map_err(js_error)?;
     let r = recommend(&spectrum, &modes, &options).map_err(js_error)?;
     to_js(&r)
+}
+
+/// The spectrum object of `recommendShaper`, typed arrays accepted.
+fn measured_spectrum(js: &JsValue) -> Result<MeasuredSpectrum, Error> {
+    let optional = |key: &str| -> Result<Option<Vec<f64>>, Error> {
+        let v = get(js, key);
+        if v.is_undefined() || v.is_null() {
+            Ok(None)
+        } else {
+            f64_vec(&v, &format!("spectrum.{key}")).map(Some)
+        }
+    };
+    let tag = |key: &str| -> JsValue {
+        let v = get(js, key);
+        if v.is_null() {
+            JsValue::UNDEFINED
+        } else {
+            v
+        }
+    };
+    let mut runs = Vec::new();
+    if let Some(list) = get(js, "runs").dyn_ref::<js_sys::Array>() {
+        for (i, run) in list.iter().enumerate() {
+            runs.push(SpectrumRun {
+                name: get(&run, "name").as_string().unwrap_or_default(),
+                values: f64_vec(&get(&run, "values"), &format!("spectrum.runs[{i}].values"))?,
+            });
+        }
+    }
+    let normalization = tag("normalization");
+    let channel = tag("channel");
+    Ok(MeasuredSpectrum {
+        frequency_hz: f64_vec(&get(js, "frequencyHz"), "spectrum.frequencyHz")?,
+        psd: f64_vec(&get(js, "psd"), "spectrum.psd")?,
+        normalization: if normalization.is_undefined() {
+            Default::default()
+        } else {
+            from_js(normalization, "spectrum.normalization")?
+        },
+        channel: if channel.is_undefined() {
+            Default::default()
+        } else {
+            from_js(channel, "spectrum.channel")?
+        },
+        psd_x: optional("psdX")?,
+        psd_y: optional("psdY")?,
+        psd_z: optional("psdZ")?,
+        psd_sum: optional("psdSum")?,
+        runs,
+    })
 }
 
 #[derive(Deserialize, Default)]

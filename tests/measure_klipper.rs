@@ -410,3 +410,145 @@ fn bad_data_is_refused_with_its_field() {
     };
     assert!(find_best_shaper(&sum_only, &opts).is_err());
 }
+
+mod via_recommend {
+    use super::dataset;
+    use input_shaping::measure::klipper::data::Normalization;
+    use input_shaping::measure::klipper::{find_best_shaper, CalibrationData, FitOptions};
+    use input_shaping::measure::recommend::{
+        recommend, Criterion, FrequencyRange, MeasuredSpectrum, RecommendOptions, SpectrumRun,
+    };
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    /// The raw (not normalised) spectrum of `modes` on Klipper's bins.
+    fn raw(modes: &[(f64, f64, f64)]) -> MeasuredSpectrum {
+        let f: Vec<f64> = (0..=1024).map(|k| k as f64 * 3200.0 / 2048.0).collect();
+        let psd = f
+            .iter()
+            .map(|&x| {
+                let mut s = 1e-4;
+                for &(fm, z, g) in modes {
+                    let r = x / fm;
+                    s += g * r.powi(4) / ((1.0 - r * r).powi(2) + (2.0 * z * r).powi(2));
+                }
+                s
+            })
+            .collect();
+        MeasuredSpectrum {
+            frequency_hz: f,
+            psd,
+            ..MeasuredSpectrum::default()
+        }
+    }
+
+    fn klipper(o: RecommendOptions) -> RecommendOptions {
+        RecommendOptions {
+            criterion: Criterion::Klipper,
+            ..o
+        }
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn the_klipper_criterion_is_find_best_shaper_on_the_normalised_spectrum() {
+        let modes = [(45.0, 0.06, 1.0), (80.0, 0.04, 0.3)];
+        let spectrum = raw(&modes);
+        // No modes needed: Klipper scans the spectrum alone.
+        let r = recommend(&spectrum, &[], &klipper(RecommendOptions::default())).unwrap();
+        let want = find_best_shaper(
+            &CalibrationData::new(dataset(&modes)),
+            &FitOptions::default(),
+        )
+        .unwrap();
+        let fit = r.klipper.as_ref().unwrap();
+        assert_eq!(fit.best, want.best);
+        for (a, b) in fit.families.iter().zip(&want.families) {
+            assert_eq!((a.name, a.pick), (b.name, b.pick));
+        }
+        // `ranked` by score, `recommended` Klipper's pick, each row Klipper's figures.
+        let best = &want.families[want.best];
+        let rec = &r.ranked[r.recommended];
+        assert_eq!(rec.family, best.name);
+        assert_eq!(rec.modes[0].frequency_hz, best.pick.freq);
+        assert_eq!(rec.remaining_vibration, best.pick.vibrs);
+        assert_eq!(rec.klipper_score, Some(best.pick.score));
+        let scores: Vec<f64> = r.ranked.iter().map(|c| c.klipper_score.unwrap()).collect();
+        assert!(scores.windows(2).all(|w| w[0] <= w[1]));
+        // A spectrum normalised already says so, and gives the same fit.
+        let normalised = MeasuredSpectrum {
+            psd: dataset(&modes).psd_sum,
+            normalization: Normalization::Klipper,
+            ..spectrum.clone()
+        };
+        let r2 = recommend(&normalised, &[], &klipper(RecommendOptions::default())).unwrap();
+        assert_eq!(r2.klipper.unwrap().families[0].pick, want.families[0].pick);
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn runs_are_kept_apart_and_options_reach_the_fit() {
+        let a = raw(&[(45.0, 0.06, 1.0)]);
+        let b = raw(&[(48.0, 0.06, 1.0)]);
+        let both = MeasuredSpectrum {
+            runs: vec![
+                SpectrumRun {
+                    name: "a".into(),
+                    values: a.psd.clone(),
+                },
+                SpectrumRun {
+                    name: "b".into(),
+                    values: b.psd.clone(),
+                },
+            ],
+            ..a.clone()
+        };
+        let opts = klipper(RecommendOptions {
+            shapers: Some(vec!["zv".into(), "ei".into()]),
+            ..RecommendOptions::default()
+        });
+        let r = recommend(&both, &[], &opts).unwrap().klipper.unwrap();
+        let mut data = CalibrationData::new(dataset(&[(45.0, 0.06, 1.0)]));
+        data.add_data(CalibrationData::new(dataset(&[(48.0, 0.06, 1.0)])))
+            .unwrap();
+        let fo = FitOptions {
+            shapers: Some(vec!["zv".into(), "ei".into()]),
+            ..FitOptions::default()
+        };
+        let want = find_best_shaper(&data, &fo).unwrap();
+        assert_eq!(r.families.len(), 2);
+        for (x, y) in r.families.iter().zip(&want.families) {
+            assert_eq!(x.pick, y.pick);
+        }
+        // maxSmoothing, a frequency list and a range.
+        let opts = klipper(RecommendOptions {
+            shapers: Some(vec!["mzv".into()]),
+            max_smoothing: Some(0.06),
+            ..RecommendOptions::default()
+        });
+        let r = recommend(&a, &[], &opts).unwrap().klipper.unwrap();
+        assert!(r.families[0].pick.smoothing <= 0.06);
+        let opts = klipper(RecommendOptions {
+            shapers: Some(vec!["mzv".into()]),
+            shaper_frequencies: Some(vec![40.0, 50.0]),
+            ..RecommendOptions::default()
+        });
+        let r = recommend(&a, &[], &opts).unwrap().klipper.unwrap();
+        assert!([40.0, 50.0].contains(&r.families[0].pick.freq));
+        let opts = klipper(RecommendOptions {
+            shapers: Some(vec!["mzv".into()]),
+            shaper_frequency_range: Some(FrequencyRange {
+                start: Some(60.0),
+                end: Some(70.0),
+                step: Some(2.5),
+            }),
+            ..RecommendOptions::default()
+        });
+        let r = recommend(&a, &[], &opts).unwrap().klipper.unwrap();
+        assert_eq!(r.families[0].scan.len(), 4);
+        // Unknown families are listed as skipped.
+        let opts = klipper(RecommendOptions {
+            shapers: Some(vec!["zv".into(), "smooth_mzv".into()]),
+            ..RecommendOptions::default()
+        });
+        let r = recommend(&a, &[], &opts).unwrap();
+        assert_eq!(r.skipped.len(), 1);
+    }
+}

@@ -30,7 +30,11 @@ fn spectrum(modes: &[(f64, f64, f64)]) -> MeasuredSpectrum {
             re * re + im * im + 1e-3
         })
         .collect();
-    MeasuredSpectrum { frequency_hz, psd }
+    MeasuredSpectrum {
+        frequency_hz,
+        psd,
+        ..MeasuredSpectrum::default()
+    }
 }
 
 #[wasm_bindgen_test(unsupported = test)]
@@ -154,6 +158,7 @@ fn recommendation_from_identified_modes() {
     let spectrum = MeasuredSpectrum {
         frequency_hz: id.spectrum.frequency_hz.clone(),
         psd: id.spectrum.psd.clone(),
+        ..MeasuredSpectrum::default()
     };
     let r = recommend(&spectrum, &modes, &RecommendOptions::default()).unwrap();
     assert!(r.ranked[r.recommended].remaining_vibration < 0.05);

@@ -6,17 +6,17 @@
 // result ({ recording, identification, recommendation, rankingError, axes }), fft
 // ({ spectrum }) or error ({ message, file, line, column }). Reading and identifying use the
 // worker's own small module (pkg/page/recording.js); the ranking designs every candidate
-// shaper, which only the page's module can, so the page hands over that module, already
-// compiled (nothing fetched again).
+// shaper.
 //
 // `axes`: one entry per machine axis (from the file names: Klipper writes
 // raw_data_<axis>_…, resonances_<axis>_…, calibration_data_<axis>_…), each with Klipper's
 // spectrum (PSD of x, y, z and their sum; several files of one axis combined as
 // calibrate_shaper.py combines them), Klipper's table (recommendShaper, criterion 'klipper'),
 // the optimised rows where the page's module has them, and the shaper curves a calibration
-// file carries.
-import initRecording, { RecordingParser, identifyModes, fftSpectrum, welch } from '../pkg/page/recording.js';
-import initPlayground, { recommendShaper } from '../pkg/page/playground.js';
+// file carries. The ranking is in the worker's own module too (recommendShaper moved there
+// with Klipper's fit, off the page's first load); the page still hands over its own module.
+import initRecording, { RecordingParser, identifyModes, fftSpectrum, welch, recommendShaper } from '../pkg/page/recording.js';
+import initPlayground from '../pkg/page/playground.js';
 
 const CHUNK_BYTES = 1 << 20;
 let ready = null; // the recording module, instantiated here
@@ -65,35 +65,39 @@ function spectrumOf(rec) {
 }
 
 /**
- * Klipper's `normalize_to_frequencies` (klippy/extras/shaper_calibrate.py, CalibrationData):
- * each PSD divided by (f + 0.1) and zeroed below 5 Hz, as calibrate_shaper.py does to raw data
- * and to resonances files (whose header has no shaper columns) after reading them.
+ * Klipper's `normalize_to_frequencies`, for the chart only (the ranking normalises in Rust,
+ * crate/measure/klipper/data.rs `normalize`, the same operations in the same order): P / (f + 0.1),
+ * and below 10 Hz × e^{1 − (10/(f + 0.1))²}.
  */
 function normalize(psd, f) {
-  return Float64Array.from(psd, (p, i) => (f[i] < 5 ? 0 : p / (f[i] + 0.1)));
+  return Float64Array.from(psd, (p, i) => {
+    let v = p / (f[i] + 0.1);
+    if (f[i] < 10) { const r = 10 / (f[i] + 0.1); v *= Math.exp(-(r * r) + 1); }
+    return v;
+  });
 }
 
-/** Klipper's spectrum of one parsed file: { frequencyHz, psdX, psdY, psdZ, psdSum, fitted }. */
+/**
+ * Klipper's spectrum of one parsed file: { frequencyHz, psdX, psdY, psdZ, psdSum, normalized,
+ * fitted } — the PSDs as read (a raw recording's by Klipper's procedure), `normalized` when
+ * they are Klipper-normalised already (calibration files).
+ */
 function klipperSpectrum(name, rec) {
   const spec = spectrumOf(rec);
   if (spec) {
     const { s, f } = spec;
-    // Calibration files hold Klipper's normalised PSD; resonances files the raw one, which
-    // calibrate_shaper.py normalises when it reads them (parse_log).
-    const kind = `${rec.format ?? ''} ${s.kind ?? ''}`;
-    const done = /calibration/i.test(kind) || s.normalized === true
-      || (typeof s.normalization === 'string' && !/^(none|raw)$/i.test(s.normalization));
-    const norm = (p) => (p ? (done ? Float64Array.from(p) : normalize(p, f)) : null);
+    const normalized = s.normalization === 'klipper' || s.normalized === true;
+    const copy = (p) => (p?.length === f.length ? Float64Array.from(p) : null);
     const fitted = (rec.shapers ?? s.shapers ?? []).map((c) => ({
       name: c.name ?? c.family, freq: c.frequencyHz ?? c.freq, values: c.values ?? c.vals,
     })).filter((c) => c.values?.length === f.length);
     return {
-      frequencyHz: Float64Array.from(f), psdX: norm(s.psdX), psdY: norm(s.psdY), psdZ: norm(s.psdZ),
-      psdSum: norm(spec.sum), fitted, kind: /calibration/i.test(kind) ? 'calibration' : 'resonances',
+      frequencyHz: Float64Array.from(f), psdX: copy(s.psdX), psdY: copy(s.psdY), psdZ: copy(s.psdZ),
+      psdSum: copy(spec.sum), normalized, fitted,
     };
   }
-  // Raw samples: Klipper's process_accelerometer_data — Welch with its settings per axis, the
-  // sum of the three, then normalize_to_frequencies (calibrate_shaper.py, calibrate_shaper).
+  // Raw samples: Klipper's process_accelerometer_data — Welch with its settings per axis and
+  // the sum of the three (calibrate_shaper.py normalises them afterwards).
   const channels = rec.channels ?? [];
   const pick = (axis) => channels.find((c) => new RegExp(`(^|_)${axis}$`, 'i').test(c.name));
   const xyz = ['x', 'y', 'z'].map(pick);
@@ -104,36 +108,47 @@ function klipperSpectrum(name, rec) {
   const f = psds.find(Boolean).frequencyHz;
   const sum = new Float64Array(f.length);
   for (const p of psds) if (p) p.psd.forEach((v, i) => { sum[i] += v; });
-  const [px, py, pz] = psds.map((p) => (p ? normalize(p.psd, f) : null));
-  return { frequencyHz: f, psdX: px, psdY: py, psdZ: pz, psdSum: normalize(sum, f), fitted: [], kind: 'raw' };
+  const [px, py, pz] = psds.map((p) => (p ? p.psd : null));
+  return { frequencyHz: f, psdX: px, psdY: py, psdZ: pz, psdSum: sum, normalized: false, fitted: [] };
 }
 
-/**
- * Several runs of one axis combined as calibrate_shaper.py combines them
- * (CalibrationData.add_data): each PSD interpolated onto the first file's bins, then the mean
- * over the files.
- */
-function combine(spectra) {
-  if (spectra.length === 1) return spectra[0];
-  const [first] = spectra;
-  const f = first.frequencyHz;
-  const interp = (fx, p) => Float64Array.from(f, (x) => {
-    let j = 1;
+/** `p` (on bins `fx`) linearly interpolated onto the bins `f`. */
+function interp(fx, p, f) {
+  if (fx === f || (fx.length === f.length && fx.every((x, i) => x === f[i]))) return p;
+  let j = 1;
+  return Float64Array.from(f, (x) => {
     while (j < fx.length - 1 && fx[j] < x) j++;
     const t = Math.min(1, Math.max(0, (x - fx[j - 1]) / (fx[j] - fx[j - 1] || 1)));
     return p[j - 1] + t * (p[j] - p[j - 1]);
   });
-  const out = { ...first, fitted: spectra.flatMap((s) => s.fitted), kind: first.kind };
-  for (const key of ['psdX', 'psdY', 'psdZ', 'psdSum']) {
-    if (spectra.some((s) => !s[key])) { out[key] = key === 'psdSum' ? first.psdSum : null; continue; }
-    const mean = new Float64Array(f.length);
-    for (const s of spectra) {
-      const p = s.frequencyHz === f ? s[key] : interp(s.frequencyHz, s[key]);
-      p.forEach((v, i) => { mean[i] += v / spectra.length; });
-    }
-    out[key] = mean;
-  }
-  return out;
+}
+
+const KEYS = ['psdX', 'psdY', 'psdZ', 'psdSum'];
+
+/**
+ * One axis's files: `rank`, the spectrum recommendShaper reads (several runs kept apart in
+ * `runs`, as Klipper's CalibrationData.add_data keeps them, on the first file's bins; normalised
+ * in Rust unless every file is), and `chart`, the normalised PSDs drawn (the mean over the runs).
+ */
+function axisSpectrum(spectra) {
+  const [first] = spectra;
+  const f = first.frequencyHz;
+  const same = spectra.every((s) => s.normalized === first.normalized);
+  // Runs of mixed normalisation: normalise the others here, then all count as normalised.
+  const norm = (s, p) => (!same && !s.normalized ? normalize(p, s.frequencyHz) : p);
+  const on = (s, key) => (s[key] ? interp(s.frequencyHz, norm(s, s[key]), f) : null);
+  const mean = (key) => {
+    if (spectra.some((s) => !s[key])) return null;
+    const m = new Float64Array(f.length);
+    for (const s of spectra) on(s, key).forEach((v, i) => { m[i] += v / spectra.length; });
+    return m;
+  };
+  const rank = { frequencyHz: f, normalization: !same || first.normalized ? 'klipper' : 'none' };
+  for (const key of KEYS) rank[key] = mean(key);
+  if (spectra.length > 1) rank.runs = spectra.map((s, i) => ({ name: s.name ?? `run ${i + 1}`, values: on(s, 'psdSum') }));
+  const chart = { frequencyHz: f, fitted: spectra.flatMap((s) => s.fitted) };
+  for (const key of KEYS) chart[key] = rank[key] && (rank.normalization === 'klipper' ? rank[key] : normalize(rank[key], f));
+  return { rank, chart };
 }
 
 /**
@@ -200,24 +215,22 @@ function row(c, f) {
 const CHANNEL_KEY = { sum: 'psdSum', x: 'psdX', y: 'psdY', z: 'psdZ' };
 
 /** Klipper's table (and the optimised rows, where available) for one axis. */
-function rankAxis(axis, spectrum, modes, channel) {
-  const f = spectrum.frequencyHz;
-  const psd = spectrum[CHANNEL_KEY[channel]] ?? spectrum.psdSum;
-  const input = { ...spectrum, psd, channel };
-  // Until the ranking reads a spectrum alone, the candidates are designed at the highest peak
-  // of the spectrum (Klipper's damping ratio 0.1) when no mode was identified.
-  let peak = 0;
-  psd.forEach((p, i) => { if (f[i] <= 200 && p > psd[peak]) peak = i; });
-  const at = modes?.length ? modes : [{ frequencyHz: f[peak], damping: 0.1 }];
-  const out = { axis, spectrum, channel, klipper: null, optimal: null, error: null };
+function rankAxis(axis, { rank, chart }, channel) {
+  const f = chart.frequencyHz;
+  const psd = rank[CHANNEL_KEY[channel]] ?? rank.psdSum;
+  const input = { ...rank, psd, channel: rank[CHANNEL_KEY[channel]] ? channel : 'sum' };
+  const out = { axis, spectrum: chart, channel: input.channel, klipper: null, optimal: null, error: null };
   try {
-    const rec = recommendShaper(input, at, { criterion: 'klipper' });
-    out.klipper = { rows: (rec.ranked ?? rec.families).map((c) => row(c, f)), selected: rec.recommended ?? rec.best };
+    const rec = recommendShaper(input, [], { criterion: 'klipper' });
+    const fit = rec.klipper;
+    out.klipper = fit
+      ? { rows: fit.families.map((c) => ({ ...row(c, f), damping: fit.dampingRatio })), selected: fit.best }
+      : { rows: rec.ranked.map((c) => row(c, f)), selected: rec.recommended };
   } catch (e) {
     out.error = e?.message ?? String(e);
   }
   try {
-    const opt = recommendShaper(input, at, { criterion: 'optimal', firmware: 'klipper' });
+    const opt = recommendShaper(input, [], { criterion: 'optimal', firmware: 'klipper' });
     const rows = opt.rows ?? opt.table ?? opt.ranked;
     if (rows?.length) out.optimal = { rows: rows.map((c) => row(c, f)), selected: opt.recommended ?? 0 };
   } catch {
@@ -235,9 +248,9 @@ function klipperAxes(files, options, modes, modesFile) {
     groups.get(axis).push({ name, rec });
   }
   return [...groups].map(([axis, list]) => {
-    const spectrum = combine(list.map(({ name, rec }) => klipperSpectrum(name, rec)));
+    const spectra = list.map(({ name, rec }) => ({ ...klipperSpectrum(name, rec), name }));
+    const ranked = rankAxis(axis, axisSpectrum(spectra), options.psdChannel ?? 'sum');
     const own = list.some(({ name }) => name === modesFile) ? modes : null;
-    const ranked = rankAxis(axis, spectrum, own, options.psdChannel ?? 'sum');
     return { ...ranked, files: list.map((x) => x.name), formats: list.map((x) => x.rec.format), modes: own ?? [] };
   });
 }

@@ -44,6 +44,17 @@ pub enum Channel {
     Z,
 }
 
+/// Whether Klipper's normalisation is applied to a spectrum (JS `"none"` | `"klipper"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Normalization {
+    /// The PSD as Welch computed it (raw recordings, `resonances_*.csv`).
+    #[default]
+    None,
+    /// Klipper's `normalize_to_frequencies` applied (`calibration_data_*.csv`).
+    Klipper,
+}
+
 /// One run: bins and PSDs (Klipper's `CalibrationData` of one data set).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Dataset {

@@ -50,7 +50,7 @@ use crate::error::{count, finite, Error, Result};
 use crate::shaper::Shaper;
 use crate::smoothing;
 use crate::vibration::vibration_rad;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use std::f64::consts::PI;
 
 /// Klipper's `MAX_FREQ`: the fit reads bins up to this frequency by default, Hz.
@@ -67,8 +67,7 @@ pub const MAX_TEST_FREQS: usize = 100_000;
 pub const MAX_TEST_DAMPING_RATIOS: usize = 32;
 
 /// The frequencies a family is scanned at.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum ShaperFreqs {
     /// An explicit list, Hz (Klipper's `--shaper_freq a,b,c`).
     List(Vec<f64>),
@@ -77,9 +76,9 @@ pub enum ShaperFreqs {
     Range([Option<f64>; 3]),
 }
 
-/// The options of Klipper's `find_best_shaper` (JS names in brackets).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase", default)]
+/// The options of Klipper's `find_best_shaper` (the JS names of
+/// [`RecommendOptions`](crate::measure::recommend::RecommendOptions) in brackets).
+#[derive(Debug, Clone, PartialEq)]
 pub struct FitOptions {
     /// Families to try, Klipper's names (`shapers`; default zv, mzv, ei, 2hump_ei, 3hump_ei).
     pub shapers: Option<Vec<String>>,
