@@ -215,7 +215,7 @@ function axisPanel(a, k) {
   const kinds = [...new Set(a.formats.map((f) => FORMAT[f] ?? f))].join(', ');
   const part = el('section', { class: 'measure-axis', 'data-axis': a.axis },
     el('h3', {}, AXIS_NAME(a.axis), ' ', el('span', { class: 'hint' },
-      `${a.files.join(', ')} (${kinds}${a.files.length > 1 ? '; combined as calibrate_shaper.py combines them' : ''})`)),
+      `${a.files.join(', ')} (${kinds}${a.files.length > 1 ? '; fitted together, runs kept apart as calibrate_shaper.py keeps them' : ''})`)),
     el('canvas', { class: 'klipper-chart', id: `klipper-chart-${k}`, 'aria-label': `${AXIS_NAME(a.axis)}: measured PSD with the shapers' vibration ratios` }),
     best ? el('p', { class: 'klipper-pick' }, `Klipper's pick: ${best.name} at ${fixed(best.freq, 1)} Hz — `
       + `vibrations ${(100 * best.vibrations).toFixed(1)} %, smoothing ${fixed(best.smoothing, 3)}, max_accel ≤ ${accel(best.maxAccel)} mm/s².`) : null,
