@@ -11,7 +11,8 @@ mod native {
     use input_shaping::command::{Command, Interpolation, Sampled, StreamingShaper};
     use input_shaping::design::zero_vibration::zv_dn;
     use input_shaping::plant::{ModalPlant, Plant};
-    use input_shaping::simulate::{run, simulate, SimulationSpec};
+    use input_shaping::scenario::{run, SimulationSpec};
+    use input_shaping::simulate::simulate;
     use input_shaping::Mode;
     use std::hint::black_box;
 

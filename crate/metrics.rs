@@ -6,8 +6,9 @@
 //! including the nonlinear pendulum; command-based ones (peaks, peak-valley count) read the
 //! command exactly where it is piecewise polynomial.
 
-use crate::command::{Command, Cursor, Piecewise};
+use crate::command::Command;
 use crate::error::Result;
+use crate::piecewise::{Cursor, Piecewise};
 use crate::plant::modal::ModalPlant;
 use crate::simulate::Trajectory;
 use serde::Serialize;

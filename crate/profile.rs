@@ -26,8 +26,8 @@
 //! §2.5: a convolution of m pulses is a spline of degree m − 1, C^{m−2}; [`to_bspline`] gives
 //! its knot vector and control polygon (eqs. 29–30 for the triangle case).
 
-use crate::command::{Cursor, Knot, Piecewise, MAX_DEGREE, ORDER};
 use crate::error::{finite, positive, Error, Result};
+use crate::piecewise::{Cursor, Knot, Piecewise, MAX_DEGREE, ORDER};
 use serde::Serialize;
 
 /// Most pulses in one profile (the position is then a polynomial of degree [`MAX_DEGREE`]).

@@ -15,8 +15,9 @@
 //! The default signal is the **velocity**: it is compactly supported for rest-to-rest moves,
 //! and a step's velocity is a Dirac, so a shaped step's spectrum is the shaper's own.
 
-use crate::command::{taylor_shift, Command, Cursor, Piecewise, Sampled};
+use crate::command::{Command, Sampled};
 use crate::error::{count, Error, Result};
+use crate::piecewise::{taylor_shift, Cursor, Piecewise};
 use crate::shaper::Shaper;
 use crate::vibration::{frequency_range, linspace, shaper_on_grid};
 use serde::{Deserialize, Serialize};
@@ -68,7 +69,7 @@ pub struct SpectrumOptions {
     pub signal: SpectrumSignal,
 }
 
-fn default_points() -> usize {
+pub(crate) fn default_points() -> usize {
     512
 }
 
@@ -316,116 +317,4 @@ pub fn command_spectrum(c: &Command, options: &SpectrumOptions) -> Result<Spectr
         Command::Piecewise(p) => piecewise_spectrum(p, options),
         Command::Sampled(s) => sampled_spectrum(s, options),
     }
-}
-
-/// A spectrum request as written in JSON: the command, optionally a shaper (`shaper`: a design
-/// `{ family, modes?, … }`, or `impulses`) and a plant (its modes are returned for marking and
-/// are the default design modes), and the frequency grid.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub struct SpectrumSpec {
-    /// The reference command.
-    pub command: crate::command::CommandSpec,
-    /// A shaper to design.
-    #[serde(default)]
-    pub shaper: Option<crate::simulate::ShaperRequest>,
-    /// An explicit shaper.
-    #[serde(default)]
-    pub impulses: Option<Vec<crate::shaper::Impulse>>,
-    /// The machine (optional).
-    #[serde(default)]
-    pub plant: Option<crate::plant::PlantSpec>,
-    /// First frequency in Hz (default 0).
-    #[serde(default)]
-    pub from_hz: f64,
-    /// Last frequency in Hz (default: 3 × the highest mode of the plant or shaper design).
-    #[serde(default)]
-    pub to_hz: Option<f64>,
-    /// Number of frequencies (default 512).
-    #[serde(default = "default_points")]
-    pub points: usize,
-    /// `"velocity"` (default), `"position"` or `"acceleration"`.
-    #[serde(default)]
-    pub signal: SpectrumSignal,
-}
-
-/// The spectra of a [`SpectrumSpec`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
-#[serde(rename_all = "camelCase")]
-pub struct SpectrumResult {
-    /// Frequencies in Hz.
-    pub frequency_hz: Vec<f64>,
-    /// |U(f)| of the shaped command (of the command itself when no shaper is given).
-    pub magnitude: Vec<f64>,
-    /// |U(f)| of the unshaped command.
-    pub unshaped: Vec<f64>,
-    /// The plant's modes in Hz, or the shaper's design modes, for marking.
-    pub modes_hz: Vec<f64>,
-}
-
-/// Computes the spectra a spec asks for.
-pub fn spectrum_for(spec: &SpectrumSpec) -> Result<SpectrumResult> {
-    let plant = match &spec.plant {
-        Some(p) => Some(crate::plant::Plant::from_spec(p).map_err(|e| e.within("plant"))?),
-        None => None,
-    };
-    let plant_modes = match &plant {
-        Some(p) => p.modes()?,
-        None => Vec::new(),
-    };
-    let default_modes = plant_modes.clone();
-    let shaper = crate::simulate::resolve_shaper(&spec.shaper, &spec.impulses, move || {
-        if default_modes.is_empty() {
-            Err(Error::invalid(
-                "shaper.modes",
-                "give the modes to design for (or a plant)",
-            ))
-        } else {
-            Ok(default_modes)
-        }
-    })?;
-    let mut modes_hz: Vec<f64> = plant_modes.iter().map(|m| m.frequency_hz()).collect();
-    if modes_hz.is_empty() {
-        if let Some(req) = &spec.shaper {
-            modes_hz = req.modes.iter().flatten().map(|m| m.frequency_hz).collect();
-        }
-    }
-    let to_hz = match spec.to_hz {
-        Some(t) => t,
-        None => {
-            let top = modes_hz.iter().fold(0.0_f64, |m, f| m.max(*f));
-            if top > 0.0 {
-                3.0 * top
-            } else {
-                return Err(Error::invalid(
-                    "toHz",
-                    "give toHz (there is no mode to scale the axis by)",
-                ));
-            }
-        }
-    };
-    let options = SpectrumOptions {
-        from_hz: spec.from_hz,
-        to_hz,
-        points: spec.points,
-        signal: spec.signal,
-    };
-    let command = Command::from_spec(&spec.command).map_err(|e| e.within("command"))?;
-    let unshaped = command_spectrum(&command, &options)?;
-    let magnitude = match &shaper {
-        Some(s) => {
-            command_spectrum(
-                &command.shaped(s).map_err(|e| e.within("command"))?,
-                &options,
-            )?
-            .magnitude
-        }
-        None => unshaped.magnitude.clone(),
-    };
-    Ok(SpectrumResult {
-        frequency_hz: unshaped.frequency_hz,
-        magnitude,
-        unshaped: unshaped.magnitude,
-        modes_hz,
-    })
 }

@@ -5,7 +5,7 @@
 //! tree first (the tag may come last), then reads the variant again from that tree; a
 //! `#[serde(flatten)]` field does the same for its whole struct. In the wasm that second
 //! deserializer compiled every variant's parser a second time, about a tenth of the code. A JS
-//! object needs no buffering: the tag is one property read. So on a JS value ([`crate::jsde`])
+//! object needs no buffering: the tag is one property read. So on a JS value (the JS boundary's reader)
 //! the tag is read first and the variant's fields from the same object; from any other
 //! deserializer (serde_json in the tests, for instance) serde's derived impl reads it as before.
 //!
@@ -25,7 +25,14 @@ pub(crate) const TAGGED: &str = "\0input-shaping tagged enum";
 /// with a flattened enum reads its own fields and then the enum from one object.
 pub(crate) const SAME: &str = "\0input-shaping same value";
 
-/// Whether `D` is the JS deserializer. Asked at run time, so it cannot leave the other branch
+/// The type name of the JS deserializer, which registers it here before its first read
+/// (`js::jsde::deserialize`). The reader sits at the top (the JS boundary) and this module at
+/// the ground, so the reader names itself rather than this module naming the reader.
+#[cfg(all(target_arch = "wasm32", feature = "any-deserializer"))]
+pub(crate) static JS_READER: std::sync::OnceLock<&'static str> = std::sync::OnceLock::new();
+
+/// Whether `D` is the JS deserializer (the type [`JS_READER`] names; no JS read yet, no JS
+/// deserializer). Asked at run time, so it cannot leave the other branch
 /// out of the wasm: where a value may only come from JS (the wasm without the
 /// `any-deserializer` feature, on by default and off in the page's build), the fallback is
 /// compiled out instead (`#[cfg]` in [`deserialize`] and [`deserialize_flat`]), or serde's
@@ -39,7 +46,9 @@ pub(crate) const SAME: &str = "\0input-shaping same value";
 pub(crate) fn is_js<'de, D: Deserializer<'de>>() -> bool {
     #[cfg(target_arch = "wasm32")]
     {
-        core::any::type_name::<D>() == core::any::type_name::<crate::jsde::De>()
+        JS_READER
+            .get()
+            .is_some_and(|name| *name == core::any::type_name::<D>())
     }
     #[cfg(not(target_arch = "wasm32"))]
     {

@@ -315,7 +315,7 @@ fn zv_damping_insensitivity_edges_match_closed_form() {
 }
 
 /// The page designs its robustness background once per (ζ, Vtol) at 1 Hz and rescales the
-/// seconds (crate/wasm.rs `robustness_rows`): every parameterless family's durations in
+/// seconds (crate/js/api.rs `robustness_rows`): every parameterless family's durations in
 /// periods and insensitivities must then not depend on the mode's frequency. Checked for
 /// frequencies two decades apart, at a damped mode, against the table designed at each.
 #[wasm_bindgen_test(unsupported = test)]

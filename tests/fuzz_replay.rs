@@ -42,8 +42,8 @@ fn seeds() -> Vec<Vec<u8>> {
 /// runs without error (otherwise the fuzzer would start from nothing useful).
 #[test]
 fn seeds_are_valid_specs_and_run() {
-    use input_shaping::simulate::SimulationSpec;
-    use input_shaping::spectrum::SpectrumSpec;
+    use input_shaping::scenario::SimulationSpec;
+    use input_shaping::scenario::SpectrumSpec;
     let seeds = files("fuzz/corpus/spec");
     assert!(
         seeds.len() >= 25,
@@ -57,11 +57,11 @@ fn seeds_are_valid_specs_and_run() {
                 .map(|_| ())
                 .map_err(|e| e.to_string())
         } else if let Ok(s) = serde_json::from_str::<SimulationSpec>(text) {
-            input_shaping::simulate::run(&s)
+            input_shaping::scenario::run(&s)
                 .map(|_| ())
                 .map_err(|e| e.to_string())
         } else if let Ok(s) = serde_json::from_str::<SpectrumSpec>(text) {
-            input_shaping::spectrum::spectrum_for(&s)
+            input_shaping::scenario::spectrum_for(&s)
                 .map(|_| ())
                 .map_err(|e| e.to_string())
         } else {

@@ -15,8 +15,8 @@ use input_shaping::chart::{self, ChartStyle};
 use input_shaping::command::{self, Command};
 use input_shaping::design::{quantize, sampled};
 use input_shaping::plant::{two_mass, Plant};
-use input_shaping::simulate::{self, SimulationSpec};
-use input_shaping::spectrum::{self, SpectrumSignal, SpectrumSpec};
+use input_shaping::scenario::{self, SimulationSpec, SpectrumSpec};
+use input_shaping::spectrum::SpectrumSignal;
 use input_shaping::vibration::*;
 use input_shaping::{export, metrics, profile, robustness, smoothing, solve};
 use input_shaping::{Error, Mode, Shaper, ShaperSpec};
@@ -282,7 +282,7 @@ proptest! {
         (from_hz, to_hz, points) in (num(0.0..5.0), prop::option::of(num(1.0..20.0)), count(2..600)),
         signal in prop::sample::select(vec![SpectrumSignal::Velocity, SpectrumSignal::Position, SpectrumSignal::Acceleration]),
     ) {
-        let shaper = shaper_spec.map(|shaper| simulate::ShaperRequest { modes: None, shaper });
+        let shaper = shaper_spec.map(|shaper| scenario::ShaperRequest { modes: None, shaper });
         let spec = SimulationSpec {
             plant: plant.clone(),
             command: command.clone(),
@@ -292,7 +292,7 @@ proptest! {
             sample_period: period,
             sample_rate_hz: rate,
         };
-        ok_or_typed(simulate::run(&spec), |r| {
+        ok_or_typed(scenario::run(&spec), |r| {
             prop_assert!(!r.time.is_empty());
             prop_assert_eq!(r.time.len(), r.unshaped.trajectory.endpoint.len());
             Ok(())
@@ -307,7 +307,7 @@ proptest! {
             points,
             signal,
         };
-        ok_or_typed(spectrum::spectrum_for(&spec), |r| {
+        ok_or_typed(scenario::spectrum_for(&spec), |r| {
             prop_assert_eq!(r.magnitude.len(), r.frequency_hz.len());
             Ok(())
         })?;

@@ -9,7 +9,8 @@ use common::close;
 use input_shaping::command::{s_curve, step, trapezoid, Command, Interpolation, Sampled};
 use input_shaping::design::zero_vibration::{zv, zvd};
 use input_shaping::metrics::peak_valley_count;
-use input_shaping::simulate::{run, SimulationSpec, MAX_SAMPLES};
+use input_shaping::scenario::{run, SimulationSpec};
+use input_shaping::simulate::MAX_SAMPLES;
 use input_shaping::spectrum::{
     command_spectrum, impulse_spectrum, SpectrumOptions, SpectrumSignal,
 };

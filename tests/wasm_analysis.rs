@@ -3,7 +3,7 @@
 //! plain JS objects in, typed or plain arrays out, and errors thrown with the field.
 #![cfg(target_arch = "wasm32")]
 
-use input_shaping::wasm;
+use input_shaping::js as wasm;
 use js_sys::{Array, Float64Array, Reflect, JSON};
 use std::f64::consts::PI;
 use wasm_bindgen::{JsCast, JsValue};

@@ -2,7 +2,7 @@
 //! with `line` / `column`, identify → recommend with plain objects.
 #![cfg(target_arch = "wasm32")]
 
-use input_shaping::wasm_measure as api;
+use input_shaping::js as api;
 use js_sys::{Float64Array, Reflect, JSON};
 use std::f64::consts::PI;
 use wasm_bindgen::{JsCast, JsValue};

@@ -5,7 +5,7 @@
 
 mod wasm_reliability;
 
-use input_shaping::wasm;
+use input_shaping::js as wasm;
 use wasm_bindgen::JsCast;
 use wasm_bindgen_test::{wasm_bindgen_test, wasm_bindgen_test_configure};
 use wasm_reliability::js;

@@ -3,7 +3,7 @@
 //! their field.
 #![cfg(target_arch = "wasm32")]
 
-use input_shaping::wasm;
+use input_shaping::js as wasm;
 use js_sys::{Reflect, JSON};
 use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_test::wasm_bindgen_test;

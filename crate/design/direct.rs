@@ -26,8 +26,8 @@ use crate::shaper::Shaper;
 use crate::solve::{self, Problem, ZeroVibration};
 use serde::{Deserialize, Serialize};
 
-/// Largest `derivatives` accepted by the direct design.
-pub const MAX_DIRECT_DERIVATIVES: u32 = 4;
+/// Largest `derivatives` accepted by the direct design: the solver's limit.
+pub const MAX_DIRECT_DERIVATIVES: u32 = solve::MAX_ZERO_DERIVATIVES;
 /// Most modes a direct design takes at once.
 pub const MAX_DIRECT_MODES: usize = 8;
 

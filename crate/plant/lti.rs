@@ -4,7 +4,9 @@
 //! derivatives. Between knots the command is a polynomial, so w' = S w (S shifts each
 //! derivative down one row) and the augmented state z = (x, w) obeys z' = M z with
 //! M = [[A, E], [0, S]]: over a step h the exact update is z(t + h) = e^{Mh} z(t) (the matrix
-//! exponential, computed by nalgebra's Padé scaling-and-squaring). A knot adds its jumps to w at
+//! exponential, computed here by balancing, then scaling and squaring a Taylor series — see
+//! `expm`; not nalgebra's Padé `exp`, which was too slow per knot; and between samples applied
+//! to one vector by its Taylor series, see `Generator`). A knot adds its jumps to w at
 //! its own time τ, so its contribution at the next sample t is e^{M(t − τ)} (impulse, jumps).
 //! Hence the response is exact (to rounding) at any sample rate, for any command built from
 //! polynomial pieces; the states are split into independent diagonal blocks (one per mode) so
@@ -13,8 +15,8 @@
 //! Outputs are rows y = C x + D w: base position/velocity/acceleration and endpoint
 //! position/velocity/acceleration.
 
-use crate::command::{Piecewise, ORDER};
 use crate::error::{Error, Result};
+use crate::piecewise::{Piecewise, ORDER};
 use nalgebra::DMatrix;
 use std::collections::HashMap;
 use std::sync::OnceLock;
@@ -66,6 +68,16 @@ const LANES: usize = 4;
 struct ModeGroup {
     starts: [usize; LANES],
     rows: Vec<[f64; 2 * LANES]>,
+}
+
+/// The command at the samples (pass 1 of [`Lti::respond`]): w[k·q + kk] is its kk-th
+/// derivative at sample k; the knots' state jumps are events, at sample `event_at[e]` the n
+/// values `event_jump[e·n ..]`.
+struct SampledCommand {
+    w: Vec<f64>,
+    q: usize,
+    event_at: Vec<usize>,
+    event_jump: Vec<f64>,
 }
 
 /// Samples of the six outputs and the final state.
@@ -286,21 +298,35 @@ impl Lti {
         samples: usize,
         keep_states: bool,
     ) -> Result<LtiResponse> {
-        let n = self.states();
         let q = command.degree() + 1;
         let maps: Vec<BlockMaps> = self
             .blocks
             .iter()
             .map(|&b| self.block_maps(b, q, sample_period))
             .collect::<Result<_>>()?;
+        let sampled = self.sample_command(command, sample_period, samples)?;
+        let groups = self.march_modes(&maps, &sampled, samples);
+        let xs = self.march_blocks(&maps, &sampled, samples);
+        let outputs = self.outputs(&groups, &xs, &sampled.w, q, samples);
+        let states = keep_states.then(|| self.states_by_sample(&groups, &xs, samples));
+        Ok(LtiResponse { outputs, states })
+    }
+
+    /// Pass 1: w[k·q + kk] = the command's kk-th derivative at sample k; the knots' state
+    /// jumps as events (sample index, n values), in sample order.
+    fn sample_command(
+        &self,
+        command: &Piecewise,
+        sample_period: f64,
+        samples: usize,
+    ) -> Result<SampledCommand> {
+        let n = self.states();
+        let q = command.degree() + 1;
         let columns = self.input_columns();
         let generators: Vec<Generator> =
             self.blocks.iter().map(|&b| self.generator(b, q)).collect();
         let mut scratch = Scratch::default();
         let knots = command.knots();
-
-        // Pass 1: w[k·q + kk] = the command's kk-th derivative at sample k; the knots' state
-        // jumps as events (sample index, n values), in sample order.
         let mut w: Vec<f64> = vec![0.0; samples * q];
         let mut event_at: Vec<usize> = Vec::new();
         let mut event_jump: Vec<f64> = Vec::new();
@@ -362,13 +388,33 @@ impl Lti {
                 taylor_shift(&anchor, t - anchor_time, wk);
             }
         }
+        Ok(SampledCommand {
+            w,
+            q,
+            event_at,
+            event_jump,
+        })
+    }
 
-        // Pass 2: the states over all samples. The 2 × 2 blocks (modes) are marched LANES at a
-        // time in one loop, so their recurrences — each a chain of dependent multiply-adds —
-        // overlap instead of running one after another. Each sample's input term
-        // cₖ = Γ wₖ₋₁ + (the knots' jumps at k) is formed first, off the chain, in the rows
-        // themselves; the chain is then xₖ = Φ xₖ₋₁ + cₖ (a multiply and two adds deep).
-        // Other blocks: xs[j][k] = state j at sample k, marched one block at a time.
+    /// Pass 2, the modes: the 2 × 2 blocks are marched LANES at a time in one loop, so their
+    /// recurrences — each a chain of dependent multiply-adds — overlap instead of running one
+    /// after another. Each sample's input term cₖ = Γ wₖ₋₁ + (the knots' jumps at k) is formed
+    /// first, off the chain, in the rows themselves; the chain is then xₖ = Φ xₖ₋₁ + cₖ (a
+    /// multiply and two adds deep).
+    fn march_modes(
+        &self,
+        maps: &[BlockMaps],
+        sampled: &SampledCommand,
+        samples: usize,
+    ) -> Vec<ModeGroup> {
+        let n = self.states();
+        let SampledCommand {
+            w,
+            q,
+            event_at,
+            event_jump,
+        } = sampled;
+        let q = *q;
         let pair_blocks: Vec<usize> = (0..self.blocks.len())
             .filter(|&b| self.blocks[b].1 == 2)
             .collect();
@@ -392,17 +438,36 @@ impl Lti {
             }
             let events = (&event_at[..], &event_jump[..], n);
             let rows = match q {
-                1 => march_group::<1>(&g, &w, events, samples),
-                2 => march_group::<2>(&g, &w, events, samples),
-                3 => march_group::<3>(&g, &w, events, samples),
-                4 => march_group::<4>(&g, &w, events, samples),
-                _ => march_group::<0>(&g, &w, events, samples),
+                1 => march_group::<1>(&g, w, events, samples),
+                2 => march_group::<2>(&g, w, events, samples),
+                3 => march_group::<3>(&g, w, events, samples),
+                4 => march_group::<4>(&g, w, events, samples),
+                _ => march_group::<0>(&g, w, events, samples),
             };
             groups.push(ModeGroup {
                 starts: g.starts,
                 rows,
             });
         }
+        groups
+    }
+
+    /// Pass 2, the other blocks: xs[j][k] = state j at sample k, marched one block at a time
+    /// (empty for the states of the modes' 2 × 2 blocks).
+    fn march_blocks(
+        &self,
+        maps: &[BlockMaps],
+        sampled: &SampledCommand,
+        samples: usize,
+    ) -> Vec<Vec<f64>> {
+        let n = self.states();
+        let SampledCommand {
+            w,
+            q,
+            event_at,
+            event_jump,
+        } = sampled;
+        let q = *q;
         let mut xs: Vec<Vec<f64>> = vec![Vec::new(); n];
         for (bm, &(start, m)) in maps.iter().zip(&self.blocks) {
             if m == 2 {
@@ -445,13 +510,23 @@ impl Lti {
                 xs[start + i] = o;
             }
         }
+        xs
+    }
 
-        // Pass 3: outputs y = C x + D w, row by row over whole columns (a mode group's rows
-        // at once).
+    /// Pass 3: outputs y = C x + D w, row by row over whole columns (a mode group's rows at
+    /// once).
+    fn outputs(
+        &self,
+        groups: &[ModeGroup],
+        xs: &[Vec<f64>],
+        w: &[f64],
+        q: usize,
+        samples: usize,
+    ) -> [Vec<f64>; OUTPUTS] {
         let mut outputs: [Vec<f64>; OUTPUTS] = Default::default();
         for (row, out) in outputs.iter_mut().enumerate() {
             *out = vec![0.0; samples];
-            for g in &groups {
+            for g in groups {
                 let mut coef = [0.0; 2 * LANES];
                 for (lane, &start) in g.starts.iter().enumerate() {
                     if start != usize::MAX {
@@ -484,40 +559,43 @@ impl Lti {
             }
             if dk.iter().any(|&v| v != 0.0) {
                 match q {
-                    1 => feedthrough::<1>(out, &w, &dk),
-                    2 => feedthrough::<2>(out, &w, &dk),
-                    3 => feedthrough::<3>(out, &w, &dk),
-                    4 => feedthrough::<4>(out, &w, &dk),
-                    _ => feedthrough::<0>(out, &w, &dk[..q]),
+                    1 => feedthrough::<1>(out, w, &dk),
+                    2 => feedthrough::<2>(out, w, &dk),
+                    3 => feedthrough::<3>(out, w, &dk),
+                    4 => feedthrough::<4>(out, w, &dk),
+                    _ => feedthrough::<0>(out, w, &dk[..q]),
                 }
             }
         }
-        let states = keep_states.then(|| {
-            // Where state j lives: (group, slot) of a mode group, or xs[j].
-            let mut at: Vec<Option<(usize, usize)>> = vec![None; n];
-            for (gi, g) in groups.iter().enumerate() {
-                for (lane, &start) in g.starts.iter().enumerate() {
-                    if start != usize::MAX {
-                        at[start] = Some((gi, lane));
-                        at[start + 1] = Some((gi, LANES + lane));
-                    }
+        outputs
+    }
+
+    /// The states sample by sample (n per sample), from the mode groups' rows and `xs`.
+    fn states_by_sample(&self, groups: &[ModeGroup], xs: &[Vec<f64>], samples: usize) -> Vec<f64> {
+        let n = self.states();
+        // Where state j lives: (group, slot) of a mode group, or xs[j].
+        let mut at: Vec<Option<(usize, usize)>> = vec![None; n];
+        for (gi, g) in groups.iter().enumerate() {
+            for (lane, &start) in g.starts.iter().enumerate() {
+                if start != usize::MAX {
+                    at[start] = Some((gi, lane));
+                    at[start + 1] = Some((gi, LANES + lane));
                 }
             }
-            let mut s = Vec::with_capacity(n * samples);
-            for k in 0..samples {
-                s.extend(at.iter().zip(&xs).map(|(loc, xj)| match *loc {
-                    Some((gi, slot)) => groups[gi].rows[k][slot],
-                    None => xj[k],
-                }));
-            }
-            s
-        });
-        Ok(LtiResponse { outputs, states })
+        }
+        let mut s = Vec::with_capacity(n * samples);
+        for k in 0..samples {
+            s.extend(at.iter().zip(xs).map(|(loc, xj)| match *loc {
+                Some((gi, slot)) => groups[gi].rows[k][slot],
+                None => xj[k],
+            }));
+        }
+        s
     }
 }
 
 /// `out[k] = Σ_{m ≥ k} state[m] hᵐ⁻ᵏ/(m − k)!`: a polynomial's derivatives shifted by `h`
-/// (the same sums, in the same order, as `command::taylor_shift`, on the first
+/// (the same sums, in the same order, as `piecewise::taylor_shift`, on the first
 /// `state.len()` derivatives only).
 #[inline]
 fn taylor_shift(state: &[f64], h: f64, out: &mut [f64]) {
@@ -539,7 +617,7 @@ fn taylor_shift_fixed<const Q: usize>(state: &[f64], h: f64, out: &mut [f64]) {
     for (d, v) in st.iter_mut().zip(state) {
         *d = *v;
     }
-    // hp[i] = hⁱ/i! by the recurrence pw *= h / i, as `command::taylor_shift` forms it (the
+    // hp[i] = hⁱ/i! by the recurrence pw *= h / i, as `piecewise::taylor_shift` forms it (the
     // constant divisions by 1 and 2 are exact, so the compiler turns them into moves and
     // multiplications without changing a bit).
     let mut hp = [1.0; Q];

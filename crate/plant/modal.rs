@@ -7,9 +7,9 @@
 //! deflection is e − u.
 
 use super::lti::{self, Lti};
-use crate::command::ORDER;
 use crate::error::{finite, Error, Result};
 use crate::mode::{Mode, ModeSpec};
+use crate::piecewise::ORDER;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 

@@ -13,9 +13,10 @@
 //! by −Δv cos θ/ℓ. A position jump (or a jump of the cable length) has no finite limit and is
 //! rejected.
 
-use crate::command::{Command, CommandSpec, Cursor, Piecewise};
+use crate::command::{Command, CommandSpec};
 use crate::error::{finite, positive, Error, Result};
 use crate::mode::Mode;
+use crate::piecewise::{Cursor, Piecewise};
 use serde::{Deserialize, Serialize};
 
 /// Most Runge–Kutta steps one simulation may take.
@@ -211,8 +212,8 @@ impl Pendulum {
                 let (_, ls) = (t, cable.state_at(t));
                 let (rdeg, ldeg) = (command.degree(), hoist.degree());
                 let rhs = |tt: f64, s: &[f64; 2]| -> Result<[f64; 2]> {
-                    let r = crate::command::taylor_shift(&rs, rdeg, tt - ts);
-                    let l = crate::command::taylor_shift(&ls, ldeg, tt - ts);
+                    let r = crate::piecewise::taylor_shift(&rs, rdeg, tt - ts);
+                    let l = crate::piecewise::taylor_shift(&ls, ldeg, tt - ts);
                     let len = l0 + l[0];
                     if len.is_nan() || len <= 0.0 {
                         return Err(Error::invalid(

@@ -13,9 +13,9 @@
 //! need an infinite impulse and is rejected.
 
 use super::lti::{self, Lti};
-use crate::command::ORDER;
 use crate::error::{finite, positive, Error, Result};
 use crate::mode::Mode;
+use crate::piecewise::ORDER;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 

@@ -303,8 +303,9 @@ fn check_frequency(field: &str, f: f64) -> Result<()> {
 
 /// Most zero-vibration constraints (modes) a problem may have.
 pub const MAX_ZEROS: usize = crate::mode::MAX_MODES;
-/// Most zero derivatives per mode (each adds two equality rows per derivative).
-pub const MAX_ZERO_DERIVATIVES: u32 = crate::design::direct::MAX_DIRECT_DERIVATIVES;
+/// Most zero derivatives per mode (each adds two equality rows per derivative); the direct
+/// family's `derivatives` limit (`design::direct::MAX_DIRECT_DERIVATIVES`) is this one.
+pub const MAX_ZERO_DERIVATIVES: u32 = 4;
 /// Most sampled limits (200 frequencies at up to 64 damping ratios).
 pub const MAX_LIMITS: usize = 200 * crate::mode::MAX_MODES;
 /// Most bands.

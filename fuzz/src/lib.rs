@@ -6,8 +6,8 @@
 //! (from the library, or from the checks below on an `Ok` result) is the bug the fuzzer
 //! reports.
 
-use input_shaping::simulate::SimulationSpec;
-use input_shaping::spectrum::SpectrumSpec;
+use input_shaping::scenario::SimulationSpec;
+use input_shaping::scenario::SpectrumSpec;
 use input_shaping::{DesignRequest, Shaper};
 
 /// Panics unless `shaper` is a valid shaper: impulses present, finite, strictly increasing in
@@ -46,13 +46,13 @@ pub fn spec(data: &[u8]) {
         }
     }
     if let Ok(sim) = serde_json::from_str::<SimulationSpec>(text) {
-        match input_shaping::simulate::run(&sim) {
+        match input_shaping::scenario::run(&sim) {
             Ok(r) => assert_eq!(r.time.len(), r.unshaped.trajectory.endpoint.len()),
             Err(e) => assert!(!e.to_string().is_empty(), "empty error for {text}"),
         }
     }
     if let Ok(spectrum) = serde_json::from_str::<SpectrumSpec>(text) {
-        match input_shaping::spectrum::spectrum_for(&spectrum) {
+        match input_shaping::scenario::spectrum_for(&spectrum) {
             Ok(r) => assert_eq!(r.magnitude.len(), r.frequency_hz.len()),
             Err(e) => assert!(!e.to_string().is_empty(), "empty error for {text}"),
         }

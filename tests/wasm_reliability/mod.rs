@@ -9,7 +9,7 @@
 //! still answers.
 #![allow(dead_code)]
 
-use input_shaping::wasm;
+use input_shaping::js as wasm;
 use js_sys::{Array, Function, Reflect, JSON};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;

@@ -85,6 +85,8 @@ fn note(error: Error) -> Error {
 pub(crate) fn deserialize<T: DeserializeOwned>(
     value: JsValue,
 ) -> std::result::Result<T, (String, Error)> {
+    #[cfg(feature = "any-deserializer")]
+    crate::tagged::JS_READER.get_or_init(core::any::type_name::<De>);
     PATH.with(|p| p.borrow_mut().clear());
     FAILED.with(|f| *f.borrow_mut() = None);
     T::deserialize(De::new(value, true)).map_err(|e| {

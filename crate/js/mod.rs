@@ -1,0 +1,28 @@
+//! Everything that exists only for JavaScript (wasm32 only): the exports the page and the
+//! library's `pkg/` call, and what only they need.
+//!
+//! - [`api`]: the JavaScript API (`design`, `residualVibration`, `sensitivity`, …, the page's
+//!   `renderPlayground` and `exportShaper`);
+//! - [`measure`]: its measured-data part (`parseRecording`, `welch`, `identifyModes`,
+//!   `recommendShaper`, `drawSpectrum`, …);
+//! - [`playground`]: the page's frame, `renderPlayground`, in its stages;
+//! - `jsde`: the reader of JS values (serde, with the path of the failing field);
+//! - `canvas`: the page's drawing backend (plotters on a 2-D canvas context).
+//!
+//! Every export is also re-exported here, so `input_shaping::js::design` is the Rust path of
+//! the JS `design`.
+
+pub mod api;
+pub(crate) mod canvas;
+pub(crate) mod jsde;
+pub mod measure;
+#[cfg(feature = "js-playground")]
+pub mod playground;
+
+// A build with only some of the export groups (Cargo features) may find one of them empty.
+#[allow(unused_imports)]
+pub use api::*;
+#[allow(unused_imports)]
+pub use measure::*;
+#[cfg(feature = "js-playground")]
+pub use playground::render_playground;

@@ -1,0 +1,160 @@
+//! The drawing of a frame: every chart whose canvas the page gave, from the frame's typed
+//! input, its analysis and its simulation. Nothing here computes what a chart shows.
+
+use super::analysis::Analysis;
+use super::simulation::{Simulation, Spectra};
+use super::state::{Frame, ViewPlant};
+use crate::chart;
+use crate::error::Error;
+use crate::js::canvas::Canvas;
+use crate::mode::Mode;
+use crate::robustness::RobustnessRow;
+use crate::shaper::Shaper;
+use crate::simulate::Trajectory;
+use crate::vibration;
+use plotters::prelude::*;
+use web_sys::HtmlCanvasElement;
+
+/// What the charts show besides the frame, its analysis and its simulation.
+pub(super) struct Extras<'a> {
+    pub robustness: &'a [RobustnessRow],
+    pub spectra: Option<&'a Spectra>,
+}
+
+fn backend(canvas: &Option<HtmlCanvasElement>) -> Option<Canvas> {
+    canvas.clone().and_then(Canvas::new)
+}
+
+/// Draws every chart the frame has a canvas for.
+pub(super) fn draw(
+    frame: &Frame,
+    analysis: &Analysis,
+    sim: &Simulation,
+    extras: &Extras<'_>,
+) -> Result<(), Error> {
+    analysis_charts(frame, analysis)?;
+    simulation_charts(frame, sim, extras.spectra)?;
+    if let Some(b) = backend(&frame.canvases.robustness) {
+        let period = frame.modes[0].damped_period_s();
+        let marks: Vec<chart::RobustnessMark<'_>> = analysis
+            .results
+            .iter()
+            .map(|r| chart::RobustnessMark {
+                label: r.label.as_str(),
+                duration_periods: r.shaper.duration / period,
+                insensitivity: r.insensitivity[0].width,
+            })
+            .collect();
+        chart::draw_robustness(
+            &b.into_drawing_area(),
+            extras.robustness,
+            &marks,
+            frame.view.vtol,
+            &frame.style,
+        )?;
+    }
+    Ok(())
+}
+
+/// The impulses, V(f), V(ζ) and the map.
+fn analysis_charts(frame: &Frame, analysis: &Analysis) -> Result<(), Error> {
+    let (modes, style, vtol) = (&frame.modes, &frame.style, Some(frame.view.vtol));
+    let named = |i: usize| frame.labels[i].as_str();
+    if let Some(b) = backend(&frame.canvases.impulses) {
+        let series: Vec<(&str, &Shaper)> = analysis
+            .shapers
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (named(i), s))
+            .collect();
+        chart::draw_impulses(&b.into_drawing_area(), &series, style)?;
+    }
+    if let Some(b) = backend(&frame.canvases.sensitivity) {
+        let series: Vec<(&str, &vibration::SensitivityCurve)> = analysis
+            .results
+            .iter()
+            .map(|r| (r.label.as_str(), &r.sensitivity))
+            .collect();
+        let modes_hz: Vec<f64> = modes.iter().map(Mode::frequency_hz).collect();
+        chart::draw_sensitivity(&b.into_drawing_area(), &series, vtol, &modes_hz, style)?;
+    }
+    if let (Some(b), Some(curves)) = (backend(&frame.canvases.damping), &analysis.damping_curves) {
+        let series: Vec<(&str, &vibration::DampingSensitivityCurve)> = curves
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (named(i), c))
+            .collect();
+        let zetas: Vec<f64> = modes.iter().map(Mode::damping).collect();
+        chart::draw_damping_sensitivity(&b.into_drawing_area(), &series, vtol, &zetas, style)?;
+    }
+    if let (Some(b), Some(map)) = (backend(&frame.canvases.map), &analysis.map) {
+        let marks: Vec<(f64, f64)> = modes
+            .iter()
+            .map(|m| (m.frequency_hz(), m.damping()))
+            .collect();
+        chart::draw_sensitivity_map_with(
+            &b.into_drawing_area(),
+            map,
+            vtol,
+            &marks,
+            style,
+            chart::MapCells::Bitmap,
+        )?;
+    }
+    Ok(())
+}
+
+/// The response, the command and its spectrum.
+fn simulation_charts(
+    frame: &Frame,
+    sim: &Simulation,
+    spectra: Option<&Spectra>,
+) -> Result<(), Error> {
+    let style = &frame.style;
+    let named = |i: usize| frame.labels[i].as_str();
+    let traj_series: Vec<(&str, &Trajectory)> = sim
+        .shaped
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (named(i), t))
+        .collect();
+    if let Some(b) = backend(&frame.canvases.response) {
+        let plant_name = match frame.view.plant {
+            ViewPlant::Modal => "",
+            ViewPlant::Pendulum { .. } => ", nonlinear pendulum",
+        };
+        let caption = format!(
+            "Simulated response (actual f = model × {}{plant_name})",
+            (frame.view.mismatch * 1e4).round() / 1e4
+        );
+        chart::draw_response(
+            &b.into_drawing_area(),
+            &sim.unshaped,
+            &traj_series,
+            &caption,
+            style,
+        )?;
+    }
+    if let Some(b) = backend(&frame.canvases.command) {
+        chart::draw_command(&b.into_drawing_area(), &sim.unshaped, &traj_series, style)?;
+    }
+    if let (Some(b), Some((u, shaped))) = (backend(&frame.canvases.spectrum), spectra) {
+        let series: Vec<(&str, &[f64])> = shaped
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (named(i), s.as_slice()))
+            .collect();
+        let modes_hz: Vec<f64> = frame.modes.iter().map(Mode::frequency_hz).collect();
+        let actual_hz: Vec<f64> = sim.plant_modes.iter().map(Mode::frequency_hz).collect();
+        chart::draw_spectrum(
+            &b.into_drawing_area(),
+            &u.frequency_hz,
+            &u.magnitude,
+            &series,
+            &modes_hz,
+            &actual_hz,
+            style,
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,332 @@
+//! Running a whole scenario as written in JSON: design the shaper a spec asks for, shape the
+//! command, [`simulate`] the plant under the unshaped and shaped commands and compute their
+//! [`metrics`] ([`run`], the one call a page frame needs), or compute their spectra
+//! ([`spectrum_for`]).
+//!
+//! This module sits above design, the commands, the plants and the results (simulate, metrics,
+//! spectrum): it is the only one that puts them together.
+
+use crate::command::{Command, CommandSpec};
+use crate::design::{design_for, ShaperSpec};
+use crate::error::{finite, positive, Error, Result};
+use crate::metrics::{metrics, mode_residual_percent, Metrics};
+use crate::mode::{Mode, ModeSpec};
+use crate::plant::{Plant, PlantSpec};
+use crate::shaper::{Impulse, Shaper, ShaperData};
+use crate::simulate::{sample_count, simulate, Trajectory, DEFAULT_SAMPLES};
+use crate::spectrum::{command_spectrum, SpectrumOptions, SpectrumSignal};
+use serde::{Deserialize, Serialize};
+
+/// The shaper of a simulation spec: a family and its parameters, designed for `modes` (or, if
+/// `modes` is left out, for the plant's own modes).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ShaperRequest {
+    /// The modes the shaper is designed for (the model); default: the plant's.
+    #[serde(default)]
+    pub modes: Option<Vec<ModeSpec>>,
+    /// The family and its parameters (as `design` takes them).
+    #[serde(flatten)]
+    pub shaper: ShaperSpec,
+}
+
+/// `{ modes?, family, …parameters }`, read as [`crate::DesignRequest`] is.
+impl<'de> Deserialize<'de> for ShaperRequest {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        struct Modes {
+            #[serde(default)]
+            modes: Option<Vec<ModeSpec>>,
+        }
+        #[derive(Deserialize)]
+        struct ShaperRequest {
+            #[serde(default)]
+            modes: Option<Vec<ModeSpec>>,
+            #[serde(flatten)]
+            shaper: ShaperSpec,
+        }
+        let (Modes { modes }, shaper) =
+            crate::tagged::deserialize_flat(d, "struct ShaperRequest", |d| {
+                let ShaperRequest { modes, shaper } = ShaperRequest::deserialize(d)?;
+                Ok((Modes { modes }, shaper))
+            })?;
+        Ok(Self { modes, shaper })
+    }
+}
+
+/// Everything a simulation needs, as written in JSON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct SimulationSpec {
+    /// The machine.
+    pub plant: PlantSpec,
+    /// The reference command (unshaped).
+    pub command: CommandSpec,
+    /// A shaper to design (`{ family, modes?, … }`); give this or `impulses`, or neither.
+    #[serde(default)]
+    pub shaper: Option<ShaperRequest>,
+    /// An explicit shaper (`[{ time, amplitude }]`).
+    #[serde(default)]
+    pub impulses: Option<Vec<Impulse>>,
+    /// Simulated time in seconds (default: until the shaped move has ended plus three periods
+    /// of the slowest mode).
+    #[serde(default)]
+    pub duration: Option<f64>,
+    /// Sample period in seconds (or give `sampleRateHz`; default: `duration`/1999, i.e. 2000
+    /// samples).
+    #[serde(default)]
+    pub sample_period: Option<f64>,
+    /// Sample rate in Hz (alternative to `samplePeriod`).
+    #[serde(default)]
+    pub sample_rate_hz: Option<f64>,
+}
+
+/// One simulated response with its metrics.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Response {
+    /// The signals.
+    #[serde(flatten)]
+    pub trajectory: Trajectory,
+    /// What the papers judge shapers by.
+    pub metrics: Metrics,
+}
+
+/// The result of [`run`].
+#[derive(Debug, Clone, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct SimulationResult {
+    /// Sample times in seconds (the same for both responses).
+    pub time: Vec<f64>,
+    /// Response to the unshaped command.
+    pub unshaped: Response,
+    /// Response to the shaped command (when a shaper was given).
+    pub shaped: Option<Response>,
+    /// The shaper used.
+    pub shaper: Option<ShaperData>,
+    /// The plant's modes in Hz (the pendulum's linearised), for marking charts.
+    pub modes_hz: Vec<f64>,
+    /// Sample period used, in seconds.
+    pub sample_period: f64,
+}
+
+/// The shaper a spec asks for (if any), validated and designed.
+pub fn spec_shaper(spec: &SimulationSpec, plant: &Plant) -> Result<Option<Shaper>> {
+    resolve_shaper(&spec.shaper, &spec.impulses, || plant.modes())
+}
+
+/// A shaper from a `shaper` design request or explicit `impulses` (at most one of them);
+/// `default_modes` supplies the modes when the request leaves them out.
+pub fn resolve_shaper(
+    shaper: &Option<ShaperRequest>,
+    impulses: &Option<Vec<Impulse>>,
+    default_modes: impl FnOnce() -> Result<Vec<Mode>>,
+) -> Result<Option<Shaper>> {
+    match (shaper, impulses) {
+        (Some(_), Some(_)) => Err(Error::invalid(
+            "impulses",
+            "give either shaper (a design) or impulses (an explicit shaper), not both",
+        )),
+        (None, None) => Ok(None),
+        (None, Some(imp)) => Ok(Some(Shaper::new(imp.clone()).map_err(|e| match e {
+            Error::InvalidInput { field, reason } if field.starts_with("impulses") => {
+                Error::InvalidInput { field, reason }
+            }
+            other => other.within("impulses"),
+        })?)),
+        (Some(req), None) => {
+            let modes = match &req.modes {
+                Some(m) => Mode::list(m).map_err(|e| e.within("shaper"))?,
+                None => default_modes()?,
+            };
+            design_for(&req.shaper, &modes)
+                .map(Some)
+                .map_err(|e| e.within("shaper"))
+        }
+    }
+}
+
+/// Runs a spec: designs the shaper, simulates the unshaped and (if a shaper is given) the
+/// shaped command on the plant, and computes the metrics of both.
+pub fn run(spec: &SimulationSpec) -> Result<SimulationResult> {
+    let plant = Plant::from_spec(&spec.plant).map_err(|e| e.within("plant"))?;
+    let command = Command::from_spec(&spec.command).map_err(|e| e.within("command"))?;
+    let shaper = spec_shaper(spec, &plant)?;
+    let shaped = match &shaper {
+        Some(s) => Some(command.shaped(s).map_err(|e| e.within("command"))?),
+        None => None,
+    };
+    let modes = plant.modes()?;
+    let slowest = modes
+        .iter()
+        .map(Mode::damped_period_s)
+        .fold(0.0_f64, f64::max);
+    let end = shaped
+        .as_ref()
+        .map_or(command.end_time(), |c| c.end_time().max(command.end_time()));
+    let duration = match spec.duration {
+        Some(d) => d,
+        None => (end + 3.0 * slowest).max(1e-3),
+    };
+    finite("duration", duration)?;
+    if duration <= 0.0 {
+        return Err(Error::invalid(
+            "duration",
+            format!("must be greater than 0 s, got {duration}"),
+        ));
+    }
+    let sample_period = match (spec.sample_period, spec.sample_rate_hz) {
+        (Some(_), Some(_)) => {
+            return Err(Error::invalid(
+                "sampleRateHz",
+                "give samplePeriod or sampleRateHz, not both",
+            ))
+        }
+        (Some(t), None) => positive("samplePeriod", t)?,
+        (None, Some(f)) => 1.0 / positive("sampleRateHz", f)?,
+        (None, None) => duration / (DEFAULT_SAMPLES - 1) as f64,
+    };
+    sample_count(sample_period, duration)?;
+    let unshaped_traj = simulate(&plant, &command, sample_period, duration)?;
+    let with_modes = |mut m: Metrics, c: &Command| -> Result<Metrics> {
+        if let Plant::Modal(mp) = &plant {
+            m.mode_residual_percent = mode_residual_percent(mp, &c.to_piecewise()?)?;
+        }
+        Ok(m)
+    };
+    let unshaped_metrics = with_modes(metrics(&unshaped_traj, &command, &command)?, &command)?;
+    let shaped_resp = match &shaped {
+        Some(c) => {
+            let t = simulate(&plant, c, sample_period, duration)?;
+            let m = with_modes(metrics(&t, c, &command)?, c)?;
+            Some(Response {
+                trajectory: t,
+                metrics: m,
+            })
+        }
+        None => None,
+    };
+    let time = unshaped_traj.time.clone();
+    Ok(SimulationResult {
+        time,
+        unshaped: Response {
+            trajectory: unshaped_traj,
+            metrics: unshaped_metrics,
+        },
+        shaped: shaped_resp,
+        shaper: shaper.map(|s| s.to_data()),
+        modes_hz: modes.iter().map(Mode::frequency_hz).collect(),
+        sample_period,
+    })
+}
+
+/// A spectrum request as written in JSON: the command, optionally a shaper (`shaper`: a design
+/// `{ family, modes?, … }`, or `impulses`) and a plant (its modes are returned for marking and
+/// are the default design modes), and the frequency grid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct SpectrumSpec {
+    /// The reference command.
+    pub command: CommandSpec,
+    /// A shaper to design.
+    #[serde(default)]
+    pub shaper: Option<ShaperRequest>,
+    /// An explicit shaper.
+    #[serde(default)]
+    pub impulses: Option<Vec<Impulse>>,
+    /// The machine (optional).
+    #[serde(default)]
+    pub plant: Option<PlantSpec>,
+    /// First frequency in Hz (default 0).
+    #[serde(default)]
+    pub from_hz: f64,
+    /// Last frequency in Hz (default: 3 × the highest mode of the plant or shaper design).
+    #[serde(default)]
+    pub to_hz: Option<f64>,
+    /// Number of frequencies (default 512).
+    #[serde(default = "crate::spectrum::default_points")]
+    pub points: usize,
+    /// `"velocity"` (default), `"position"` or `"acceleration"`.
+    #[serde(default)]
+    pub signal: SpectrumSignal,
+}
+
+/// The spectra of a [`SpectrumSpec`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct SpectrumResult {
+    /// Frequencies in Hz.
+    pub frequency_hz: Vec<f64>,
+    /// |U(f)| of the shaped command (of the command itself when no shaper is given).
+    pub magnitude: Vec<f64>,
+    /// |U(f)| of the unshaped command.
+    pub unshaped: Vec<f64>,
+    /// The plant's modes in Hz, or the shaper's design modes, for marking.
+    pub modes_hz: Vec<f64>,
+}
+
+/// Computes the spectra a spec asks for.
+pub fn spectrum_for(spec: &SpectrumSpec) -> Result<SpectrumResult> {
+    let plant = match &spec.plant {
+        Some(p) => Some(Plant::from_spec(p).map_err(|e| e.within("plant"))?),
+        None => None,
+    };
+    let plant_modes = match &plant {
+        Some(p) => p.modes()?,
+        None => Vec::new(),
+    };
+    let default_modes = plant_modes.clone();
+    let shaper = resolve_shaper(&spec.shaper, &spec.impulses, move || {
+        if default_modes.is_empty() {
+            Err(Error::invalid(
+                "shaper.modes",
+                "give the modes to design for (or a plant)",
+            ))
+        } else {
+            Ok(default_modes)
+        }
+    })?;
+    let mut modes_hz: Vec<f64> = plant_modes.iter().map(|m| m.frequency_hz()).collect();
+    if modes_hz.is_empty() {
+        if let Some(req) = &spec.shaper {
+            modes_hz = req.modes.iter().flatten().map(|m| m.frequency_hz).collect();
+        }
+    }
+    let to_hz = match spec.to_hz {
+        Some(t) => t,
+        None => {
+            let top = modes_hz.iter().fold(0.0_f64, |m, f| m.max(*f));
+            if top > 0.0 {
+                3.0 * top
+            } else {
+                return Err(Error::invalid(
+                    "toHz",
+                    "give toHz (there is no mode to scale the axis by)",
+                ));
+            }
+        }
+    };
+    let options = SpectrumOptions {
+        from_hz: spec.from_hz,
+        to_hz,
+        points: spec.points,
+        signal: spec.signal,
+    };
+    let command = Command::from_spec(&spec.command).map_err(|e| e.within("command"))?;
+    let unshaped = command_spectrum(&command, &options)?;
+    let magnitude = match &shaper {
+        Some(s) => {
+            command_spectrum(
+                &command.shaped(s).map_err(|e| e.within("command"))?,
+                &options,
+            )?
+            .magnitude
+        }
+        None => unshaped.magnitude.clone(),
+    };
+    Ok(SpectrumResult {
+        frequency_hz: unshaped.frequency_hz,
+        magnitude,
+        unshaped: unshaped.magnitude,
+        modes_hz,
+    })
+}
