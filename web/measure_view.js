@@ -170,10 +170,11 @@ function show(data) {
   $('measure-modes-part').hidden = !id;
   if (id && r) {
     fillChannels(r.channels, id.channel);
-    status(`${FORMAT[r.format] ?? r.format}${r.sampleRateHz ? `: ${r.rows.toLocaleString('en')} samples ` : ' '}`
+    $('measure-channel').parentElement.hidden = r.channels.length === 0;
+    status(`${FORMAT[r.format] ?? r.format}${r.sampleRateHz ? `: ${r.rows.toLocaleString('en')} samples ` : ''}`
       + `${r.sampleRateHz ? `at ${fmt(r.sampleRateHz, 6)} Hz over ${fmt(r.durationS, 4)} s` : ''}`
-      + `${r.resampled ? ` (uneven time stamps, jitter ${pct(r.timing.jitter)}, resampled)` : ''}; channel ${id.channel}; `
-      + `${id.spectrum.segmentLength ? `Welch PSD with ${id.spectrum.segmentLength}-sample segments (${fmt(id.spectrum.resolutionHz, 3)} Hz bins, ${id.spectrum.segments} averaged)` : `the file's spectrum (${fmt(id.spectrum.resolutionHz, 3)} Hz bins)`}`
+      + `${r.resampled ? ` (uneven time stamps, jitter ${pct(r.timing.jitter)}, resampled)` : ''}; channel ${id.channel ?? 'sum'}; `
+      + `${id.spectrum.segments ? `Welch PSD with ${id.spectrum.segmentLength}-sample segments (${fmt(id.spectrum.resolutionHz, 3)} Hz bins, ${id.spectrum.segments} averaged)` : `the file's spectrum (${fmt(id.spectrum.resolutionHz, 3)} Hz bins)`}`
       + `${id.freeDecay ? `; free decay found at ${fmt(id.freeDecay.startS, 3)}–${fmt(id.freeDecay.endS, 3)} s` : ''}.`);
     showModes(id);
     showRecommendation(data.recommendation);

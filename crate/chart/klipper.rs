@@ -167,8 +167,10 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
         .fold(0.0_f64, f64::max);
     let threshold: Vec<f64> = fs.iter().map(|f| slope * (f + 5.0) / 33.3).collect();
 
+    // The sum wider than the axes: on one axis's test it is nearly that axis's curve, drawn
+    // over it, and still shows as a purple border.
     let mut curves: Vec<(&str, &[f64], RGBColor, f64)> =
-        vec![("X+Y+Z", &chart.psd_sum[..shown], PSD_COLORS[0], 1.5)];
+        vec![("X+Y+Z", &chart.psd_sum[..shown], PSD_COLORS[0], 3.0)];
     for (label, v, color) in [
         ("X", chart.psd_x, PSD_COLORS[1]),
         ("Y", chart.psd_y, PSD_COLORS[2]),
