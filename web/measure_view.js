@@ -223,6 +223,7 @@ function axisPanel(a, k) {
     a.error ? el('p', { class: 'error' }, `Could not rank the shapers: ${a.error}`) : null,
     rows.length ? rowsTable('klipper-table', rows, sel, 'As calibrate_shaper.py ranks them', false) : null,
     a.optimal ? rowsTable('optimal-table', a.optimal.rows, a.optimal.selected, "Klipper's pick, the best mainline-Klipper shaper and the best custom shaper, by Klipper's score", true) : null,
+    a.optimal?.note ? el('p', { class: 'hint optimal-note' }, a.optimal.note) : null,
     a.spectrum.fitted.length ? el('p', { class: 'hint' }, `Dotted: the shapers Klipper fitted, as the file has them — ${a.spectrum.fitted.map((c) => `${c.name}${Number.isFinite(c.freq) ? ` (${fixed(c.freq, 1)} Hz)` : ''}`).join(', ')}.`) : null);
   return part;
 }

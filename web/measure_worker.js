@@ -232,7 +232,7 @@ function rankAxis(axis, { rank, chart }, channel) {
   try {
     const opt = recommendShaper(input, [], { criterion: 'optimal', firmware: 'klipper' });
     const rows = opt.rows ?? opt.table ?? opt.ranked;
-    if (rows?.length) out.optimal = { rows: rows.map((c) => row(c, f)), selected: opt.recommended ?? 0 };
+    if (rows?.length) out.optimal = { rows: rows.map((c) => row(c, f)), selected: opt.recommended ?? 0, note: opt.note ?? '' };
   } catch {
     // 'optimal' is not in this module's ranking (yet): the table shows Klipper's rows only.
   }
