@@ -3,6 +3,9 @@
 #   main.js            web/main.js with the modules it imports (page, state, params, dom,
 #                      editors, results, designs, measure) and the
 #                      playground module's glue (index.html loads it);
+#   measure_view.js    web/measure_view.js (the measured-data view) with the recording module's
+#                      glue (it draws the Klipper-style charts); imported by main.js when the
+#                      measured-data path is first opened;
 #   measure_worker.js  web/measure_worker.js with the recording module's glue and the
 #                      playground module's (it ranks shapers with the page's module, which
 #                      main.js hands it compiled); started when the first recording is opened;
@@ -14,4 +17,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 common=(--bundle --minify --format=esm --target=es2020 --sourcemap --outdir=pkg/page --log-level=warning)
-node_modules/.bin/esbuild web/main.js web/measure_worker.js web/design_worker.js "${common[@]}"
+node_modules/.bin/esbuild web/main.js web/measure_view.js web/measure_worker.js web/design_worker.js "${common[@]}"

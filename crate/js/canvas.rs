@@ -160,7 +160,10 @@ fn fine_lines(from: BackendCoord, to: BackendCoord) -> ((f64, f64), (f64, f64)) 
 
 impl Canvas {
     /// The backend for `canvas`, or `None` if it has no 2-D context.
-    #[cfg_attr(not(feature = "js-playground"), allow(dead_code))] // the recording module draws nothing
+    #[cfg_attr(
+        not(any(feature = "js-playground", feature = "js-recording")),
+        allow(dead_code)
+    )] // the designer module draws nothing
     pub(crate) fn new(canvas: HtmlCanvasElement) -> Option<Canvas> {
         let context = canvas
             .get_context("2d")

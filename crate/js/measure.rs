@@ -296,8 +296,9 @@ impl JsRecordingParser {
 /// symmetricWindow?, detrend?, scaling? })` → `{ frequencyHz, psd (Float64Array),
 /// segmentLength, overlap, segments, resolutionHz, enbwBins, sampleRateHz }`; `signal` is a
 /// `Float64Array` or an array of numbers. `{ preset: 'klipper', sampleRateHz }` takes
-/// Klipper's settings instead.
-#[cfg(feature = "js-api")]
+/// Klipper's settings instead. (In the recording module too: the page's measured-data worker
+/// forms Klipper's spectra of raw recordings with it.)
+#[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = welch)]
 pub fn welch_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
     let x = f64_vec(&signal, "signal").map_err(js_error)?;
@@ -651,6 +652,99 @@ pub fn draw_spectrum(
         &style,
     )
     .map_err(js_error)
+}
+
+/// A `#rrggbb` colour.
+#[cfg(feature = "js-recording")]
+fn css_hex(s: &str) -> Option<RGBColor> {
+    let h = s.strip_prefix('#').filter(|h| h.len() == 6)?;
+    let byte = |i: usize| u8::from_str_radix(h.get(i..i + 2)?, 16).ok();
+    Some(RGBColor(byte(0)?, byte(2)?, byte(4)?))
+}
+
+#[cfg(feature = "js-recording")]
+#[derive(Deserialize, Default)]
+#[serde(rename_all = "camelCase", default)]
+struct KlipperDrawOptions {
+    max_hz: Option<f64>,
+    pixel_ratio: Option<f64>,
+    title: Option<String>,
+}
+
+/// `drawKlipperChart(canvas, { frequencyHz, psdSum, psdX?, psdY?, psdZ?, shapers?: [{ values,
+/// color?: '#rrggbb', selected?, dotted? }], after? }, { maxHz?, pixelRatio?, title? })`: the
+/// measured frequency response as Klipper's `calibrate_shaper.py` draws it — the PSDs on a
+/// linear axis, each shaper's vibration ratio V(f) (`values`, one per frequency) on a second
+/// axis 0 … 1, and the PSD after the `selected` shaper (`after`, or `psdSum`·V). Colours left
+/// out are matplotlib's cycle, as in Klipper's figure; `maxHz` defaults to 200 (Klipper's).
+#[cfg(feature = "js-recording")]
+#[wasm_bindgen(js_name = drawKlipperChart)]
+pub fn draw_klipper_chart(
+    canvas: HtmlCanvasElement,
+    data: JsValue,
+    options: JsValue,
+) -> Result<(), JsValue> {
+    let vec = |key: &str| f64_vec(&get(&data, key), key).map_err(js_error);
+    let optional = |key: &str| -> Result<Option<Vec<f64>>, JsValue> {
+        let v = get(&data, key);
+        if v.is_undefined() || v.is_null() {
+            Ok(None)
+        } else {
+            f64_vec(&v, key).map(Some).map_err(js_error)
+        }
+    };
+    let frequency_hz = vec("frequencyHz")?;
+    let psd_sum = vec("psdSum")?;
+    let (psd_x, psd_y, psd_z) = (optional("psdX")?, optional("psdY")?, optional("psdZ")?);
+    let after = optional("after")?;
+    let mut curves = Vec::new();
+    let shapers = get(&data, "shapers");
+    if let Some(list) = shapers.dyn_ref::<js_sys::Array>() {
+        for (k, s) in list.iter().enumerate() {
+            let values =
+                f64_vec(&get(&s, "values"), &format!("shapers[{k}].values")).map_err(js_error)?;
+            let color = get(&s, "color").as_string().and_then(|c| css_hex(&c));
+            curves.push((
+                values,
+                color,
+                get(&s, "selected").is_truthy(),
+                get(&s, "dotted").is_truthy(),
+            ));
+        }
+    }
+    let o: KlipperDrawOptions = self::options(options, "options").map_err(js_error)?;
+    let chart = chart::KlipperChart {
+        frequency_hz: &frequency_hz,
+        psd_sum: &psd_sum,
+        psd_x: psd_x.as_deref(),
+        psd_y: psd_y.as_deref(),
+        psd_z: psd_z.as_deref(),
+        shapers: curves
+            .iter()
+            .map(|(values, color, selected, dotted)| chart::ShaperCurve {
+                values,
+                color: *color,
+                selected: *selected,
+                dotted: *dotted,
+            })
+            .collect(),
+        after: after.as_deref(),
+        max_hz: o.max_hz,
+        title: o.title.as_deref(),
+    };
+    let style = ChartStyle {
+        scale: o
+            .pixel_ratio
+            .filter(|r| r.is_finite() && *r > 0.0)
+            .unwrap_or(1.0),
+        ..ChartStyle::default()
+    };
+    let backend = Canvas::new(canvas).ok_or_else(|| {
+        js_error(Error::Render {
+            reason: "the canvas has no 2D context".into(),
+        })
+    })?;
+    chart::draw_klipper_chart(&backend.into_drawing_area(), &chart, &style).map_err(js_error)
 }
 
 /// `firmwareConfig({ firmware, axes })` → `{ text, warnings }`: the config text of the shaper

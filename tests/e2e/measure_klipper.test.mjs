@@ -1,0 +1,135 @@
+// End-to-end: the measured-data path of issue 20 (item 5). Klipper's files from tests/data/klipper/
+// (written by benches/reference/sweep_testset.py, with Klipper's own picks for them computed by
+// benches/reference/klipper_reference.py in expected.json) go in through the file input, one or
+// several at once; per axis the page must show the Klipper-style chart (pixels on the canvas),
+// the table like calibrate_shaper's, whose pick must be Klipper's (family, and frequency to
+// 0.1 Hz), and the config text; a bad file must name file, line and column beside the drop
+// zone and keep the last good result; no console errors.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import { openBrowser, canvasInfo, SCREENSHOTS } from './browser.mjs';
+
+const DATA = new URL('../data/klipper/', import.meta.url);
+const EXPECTED = JSON.parse(readFileSync(new URL('expected.json', DATA), 'utf8'));
+const file = (name) => ({ name, mimeType: 'text/csv', buffer: readFileSync(new URL(name, DATA)) });
+
+let env;
+before(async () => { env = await openBrowser(); });
+after(async () => { await env?.close(); });
+
+/** Sets the files on the input and waits for the panels of `axes` to be drawn. */
+async function drop(page, names, axes) {
+  const before = await page.evaluate(() => window.__measureView?.result ?? null);
+  await page.setInputFiles('#measure-file', names.map(file));
+  await page.waitForFunction(([prev, want]) => {
+    const r = window.__measureView?.result;
+    if (!r || r === prev) return false;
+    const shown = [...document.querySelectorAll('.measure-axis')].map((s) => s.dataset.axis);
+    return want.every((a) => shown.includes(a))
+      && [...document.querySelectorAll('canvas.klipper-chart')].every((c) => c.dataset.drawn);
+  }, [before, axes], { timeout: 180000 });
+}
+
+/** The table of an axis as shown: [{ family, frequency, best }]. */
+function table(page, axis) {
+  return page.$$eval(`.measure-axis[data-axis="${axis}"] table.klipper-table tbody tr`, (rows) => rows.map((r) => ({
+    family: r.dataset.family, frequency: Number(r.dataset.frequency), shown: r.cells[2].textContent, best: r.classList.contains('best'),
+  })));
+}
+
+/** Klipper's pick from expected.json, checked against the row the page marks. */
+function assertKlipperPick(rows, key) {
+  const want = EXPECTED[key].best;
+  const best = rows.find((r) => r.best);
+  assert.ok(best, `a pick is marked: ${JSON.stringify(rows)}`);
+  assert.equal(best.family, want.name, `${key}: family (${JSON.stringify(rows)})`);
+  assert.equal(best.shown, want.freq.toFixed(1), `${key}: frequency as calibrate_shaper prints it`);
+  assert.ok(Math.abs(best.frequency - want.freq) <= 0.05 + 1e-9, `${key}: ${best.frequency} Hz against ${want.freq}`);
+}
+
+test('"I have a recording" at the top opens the path; the view is fetched only then', async () => {
+  const { page, problems, fetched } = await env.page();
+  assert.ok(!fetched.includes('/pkg/page/measure_view.js'), 'not in the first load');
+  assert.ok(!fetched.includes('/pkg/page/recording_bg.wasm'), 'not in the first load');
+  await page.click('#open-recording');
+  await page.waitForFunction(() => document.body.dataset.path === 'recording');
+  await page.waitForFunction(() => window.__measureView !== undefined, null, { timeout: 30000 });
+  assert.ok(fetched.includes('/pkg/page/measure_view.js'), fetched.join(' '));
+  // The measured-data section comes first in the layout and is scrolled to.
+  const top = await page.evaluate(() => document.getElementById('measure').getBoundingClientRect().top);
+  assert.ok(top < 200, `the section is at the top: ${top}`);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('a raw Klipper recording: the axis chart, Klipper\'s table and the config', async () => {
+  const { page, problems } = await env.page({ width: 1280, height: 1000 });
+  await drop(page, ['raw_data_x_single47z08.csv'], ['x']);
+  const rows = await table(page, 'x');
+  assert.ok(rows.length >= 5, JSON.stringify(rows));
+  const chart = await canvasInfo(page, 'klipper-chart-0');
+  assert.ok(chart.ink > 5000, `the chart has ink: ${chart.ink}`);
+  const config = await page.inputValue('#measure-config-text');
+  const best = rows.find((r) => r.best);
+  // The frequency as written by firmwareConfig: calibrate_shaper's 0.1 Hz, without a trailing 0.
+  const freq = String(Number(best.frequency.toFixed(1)));
+  assert.ok(config.startsWith(`[input_shaper]\nshaper_type_x: ${best.family}\nshaper_freq_x: ${freq}\ndamping_ratio_x: 0.1\n`), config);
+  assert.match(config, /# in \[printer\]: max_accel: \d+00\n/, config);
+  await page.selectOption('#measure-config-format', 'klipperCommand');
+  assert.equal(await page.inputValue('#measure-config-text'),
+    `SET_INPUT_SHAPER SHAPER_TYPE_X=${best.family} SHAPER_FREQ_X=${freq} DAMPING_RATIO_X=0.1\n`);
+  // A firmware that cannot run the pick says so beside the (empty) text, or writes it with a note.
+  await page.selectOption('#measure-config-format', 'marlin');
+  assert.match(await page.inputValue('#measure-config-text'), /^; x: Marlin runs ZV only/);
+  // The raw recording's modes are identified, for the playground.
+  await page.waitForSelector('#measure-modes tbody tr[data-mode]');
+  assert.equal(await page.isDisabled('#measure-accept'), false);
+  await page.locator('#measure').screenshot({ path: `${SCREENSHOTS}measure-klipper-raw.png` });
+  assertKlipperPick(rows, 'raw_data_x_single47z08.csv');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('resonances and calibration files, X and Y together, then a bad file keeps the result', async () => {
+  const { page, problems } = await env.page({ width: 1280, height: 1000 });
+  await drop(page, ['resonances_x_single47z08.csv', 'calibration_data_y_two38x14.csv'], ['x', 'y']);
+  const x = await table(page, 'x');
+  const y = await table(page, 'y');
+  for (const k of [0, 1]) assert.ok((await canvasInfo(page, `klipper-chart-${k}`)).ink > 5000, `chart ${k} has ink`);
+  // The calibration file's fitted curves are drawn (dotted) and named.
+  assert.match(await page.textContent('.measure-axis[data-axis="y"]'), /Dotted: the shapers Klipper fitted/);
+  const config = await page.inputValue('#measure-config-text');
+  assert.match(config, /shaper_type_x: .*\nshaper_freq_x: .*\n(.*\n)*shaper_type_y: /, config);
+  await page.locator('#measure').screenshot({ path: `${SCREENSHOTS}measure-klipper-xy.png` });
+  await page.screenshot({ path: `${SCREENSHOTS}measure-klipper-full.png`, fullPage: true });
+  const hash = (await canvasInfo(page, 'klipper-chart-0')).hash;
+
+  // A bad file: the message names file, line and column; the panels and the config stay.
+  await page.setInputFiles('#measure-file', { name: 'resonances_x_bad.csv', mimeType: 'text/csv', buffer: Buffer.from('freq,psd_x,psd_y,psd_z,psd_xyz\n5.0,1,2,3,6\n6.0,1,abc,3,6\n') });
+  await page.waitForFunction(() => document.getElementById('measure-error').textContent !== '');
+  const error = await page.textContent('#measure-error');
+  assert.match(error, /resonances_x_bad\.csv/);
+  assert.match(error, /line 3, column 3/);
+  assert.equal(await page.inputValue('#measure-config-text'), config, 'the config stays');
+  assert.deepEqual(await table(page, 'x'), x, 'the table stays');
+  assert.equal((await canvasInfo(page, 'klipper-chart-0')).hash, hash, 'the chart stays');
+  // The error sits beside the drop zone.
+  assert.ok(await page.$('#measure-drop #measure-error'));
+  await page.locator('#measure-drop').screenshot({ path: `${SCREENSHOTS}measure-klipper-error.png` });
+
+  assertKlipperPick(x, 'resonances_x_single47z08.csv');
+  assertKlipperPick(y, 'calibration_data_y_two38x14.csv');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('two runs of one axis are combined into one panel', async () => {
+  const { page, problems } = await env.page();
+  await drop(page, ['resonances_x_m1.csv', 'resonances_x_m1run2.csv'], ['x']);
+  assert.equal(await page.$$eval('.measure-axis', (s) => s.length), 1);
+  assert.match(await page.textContent('.measure-axis[data-axis="x"] h3'), /resonances_x_m1\.csv, resonances_x_m1run2\.csv/);
+  assertKlipperPick(await table(page, 'x'), 'resonances_x_m1+resonances_x_m1run2');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
