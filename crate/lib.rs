@@ -89,11 +89,6 @@ pub mod vibration;
 
 #[cfg(target_arch = "wasm32")]
 pub mod js;
-// The old paths `crate::wasm` and `crate::canvas`, which js/measure.rs still names (it moved
-// from wasm_measure.rs unchanged while other branches add exports to it): to be replaced by
-// `super::api` and `super::canvas` there once those branches are merged.
-#[cfg(target_arch = "wasm32")]
-use js::{api as wasm, canvas};
 
 pub use design::{design, DesignRequest, ShaperSpec};
 pub use error::{Error, Result};

@@ -8,7 +8,8 @@
 //! Cargo.toml). A build with only some of them leaves helpers unused, hence the allow there.
 #![cfg_attr(not(feature = "js-api"), allow(dead_code, unused_imports))]
 
-use crate::canvas::Canvas;
+use super::api::{from_js, js_error, set, to_js};
+use super::canvas::Canvas;
 use crate::chart::{self, ChartStyle};
 use crate::error::Error;
 use crate::measure::identify::{identify, identify_spectrum, IdentifyOptions};
@@ -19,7 +20,6 @@ use crate::measure::recommend::{
 use crate::measure::recording::Parsed;
 use crate::measure::recording::{self, Recording, RecordingError, RecordingOptions};
 use crate::measure::spectrum_file::{Normalization, SpectrumFile};
-use crate::wasm::{from_js, js_error, set, to_js};
 use plotters::prelude::*;
 use serde::Deserialize;
 use wasm_bindgen::prelude::*;
