@@ -12,6 +12,10 @@
 //!
 //! Native only (reads files).
 
+use input_shaping::export::{
+    self,
+    firmware::{firmware_config, AxisShaper},
+};
 use input_shaping::measure::klipper::{
     find_best_shaper, klipper_figures_on, CalibrationData, Channel, Dataset, FitOptions,
 };
@@ -19,7 +23,7 @@ use input_shaping::measure::optimal::{
     optimal, Firmware, OptimalOptions, OptimalReport, MIN_CUSTOM_AMPLITUDE,
 };
 use input_shaping::measure::recommend::MeasuredMode;
-use input_shaping::shaper::Shaper;
+use input_shaping::shaper::{Impulse, Shaper};
 use std::path::Path;
 
 const DIR: &str = "tests/data/klipper";
@@ -114,9 +118,31 @@ fn check(name: &str, firmware: Firmware) -> OptimalReport {
         let duration = imps.last().unwrap().time;
         assert!(duration <= limits.max_duration_s && duration >= limits.min_duration_s);
         assert!(imps.windows(2).all(|w| w[1].time > w[0].time));
+        // The config text comes from the export layer (crate::export::firmware), which checks
+        // the firmware's limits again as written.
+        let shaper = Shaper::new(
+            imps.iter()
+                .map(|i| Impulse {
+                    time: i.time,
+                    amplitude: i.amplitude,
+                })
+                .collect(),
+        )
+        .unwrap();
+        let axis = [AxisShaper::custom("x", &shaper)];
         match firmware {
-            Firmware::Reprapfirmware => assert!(custom.config.starts_with("M593 P\"custom\" H")),
-            _ => assert!(custom.config.contains("shaper_type_x: custom")),
+            Firmware::Reprapfirmware => {
+                let text = firmware_config(export::firmware::Firmware::Rrf, &axis)
+                    .unwrap()
+                    .text;
+                assert!(text.contains("M593 P\"custom\" H"), "{text}");
+            }
+            _ => {
+                let text = firmware_config(export::firmware::Firmware::Kalico, &axis)
+                    .unwrap()
+                    .text;
+                assert!(text.contains("shaper_type_x: custom"), "{text}");
+            }
         }
         assert_eq!(r.recommended, 2);
     } else {

@@ -242,8 +242,6 @@ pub struct OptimalRow {
     pub robust_score: f64,
     /// 1 − score / Klipper pick's score (Klipper's own scoring).
     pub improvement: f64,
-    /// Config text for the firmware.
-    pub config: String,
 }
 
 /// The table of [`optimal`].
@@ -867,28 +865,6 @@ fn prepared(data: &CalibrationData) -> Result<Vec<(Vec<f64>, Vec<f64>)>> {
     Ok(out)
 }
 
-fn family_config(family: &str, freq: f64, dr: f64) -> String {
-    format!(
-        "[input_shaper]\nshaper_type_x: {family}\nshaper_freq_x: {freq:.2}\ndamping_ratio_x: {dr:.3}"
-    )
-}
-
-fn custom_config(firmware: Firmware, shaper: &Shaper) -> String {
-    let imps = shaper.impulses();
-    match firmware {
-        Firmware::Reprapfirmware => crate::export::to_rrf_m593(shaper).unwrap_or_default(),
-        _ => {
-            let a: Vec<String> = imps.iter().map(|i| format!("{:.6}", i.amplitude)).collect();
-            let t: Vec<String> = imps.iter().map(|i| format!("{:.6}", i.time)).collect();
-            format!(
-                "[input_shaper]\nshaper_type_x: custom\nshaper_a_x: {}\nshaper_t_x: {}",
-                a.join(", "),
-                t.join(", ")
-            )
-        }
-    }
-}
-
 /// Klipper's own figures of `shaper` on `data`, by the crate's reproduction
 /// ([`klipper_figures_on`]: R over 0.075 / 0.1 / 0.15 and the runs, bins ≤ 200 Hz).
 fn own_figures(shaper: &Shaper, data: &CalibrationData, scv: f64) -> Result<Figures> {
@@ -971,7 +947,6 @@ pub fn optimal(
             robust_vibrations: e.robust_r,
             robust_score: e.robust_score(),
             improvement: 1.0 - fig.score / bounds.score,
-            config: family_config(m.family, m.freq, m.damping_ratio),
         })
     };
     let mut rows = vec![row_of("klipper", &pick)?, row_of("mainline", &main)?];
@@ -1022,7 +997,6 @@ pub fn optimal(
             family: "custom".into(),
             shaper_freq_hz: None,
             damping_ratio: None,
-            config: custom_config(options.firmware, &shaper),
             shaper: shaper.to_data(),
             klipper: fig,
             robust_vibrations: e.robust_r,
