@@ -624,18 +624,7 @@ pub fn draw_spectrum(
         .iter()
         .map(|&f| (f, format!("{f:.2} Hz")))
         .collect();
-    let style = ChartStyle {
-        scale: o
-            .pixel_ratio
-            .filter(|r| r.is_finite() && *r > 0.0)
-            .unwrap_or(1.0),
-        ..ChartStyle::default()
-    };
-    let backend = Canvas::new(canvas).ok_or_else(|| {
-        js_error(Error::Render {
-            reason: "the canvas has no 2D context".into(),
-        })
-    })?;
+    let (backend, style) = canvas_and_style(canvas, o.pixel_ratio)?;
     let titles = (
         o.title.as_deref().unwrap_or(chart::measured::PSD_TITLES.0),
         o.y_label
@@ -652,6 +641,26 @@ pub fn draw_spectrum(
         &style,
     )
     .map_err(js_error)
+}
+
+/// The canvas's drawing backend and the chart style scaled by `pixel_ratio` (1 when absent or
+/// not a positive number): what both measured-data charts start from.
+fn canvas_and_style(
+    canvas: HtmlCanvasElement,
+    pixel_ratio: Option<f64>,
+) -> Result<(Canvas, ChartStyle), JsValue> {
+    let style = ChartStyle {
+        scale: pixel_ratio
+            .filter(|r| r.is_finite() && *r > 0.0)
+            .unwrap_or(1.0),
+        ..ChartStyle::default()
+    };
+    let backend = Canvas::new(canvas).ok_or_else(|| {
+        js_error(Error::Render {
+            reason: "the canvas has no 2D context".into(),
+        })
+    })?;
+    Ok((backend, style))
 }
 
 /// A `#rrggbb` colour.
@@ -732,18 +741,7 @@ pub fn draw_klipper_chart(
         max_hz: o.max_hz,
         title: o.title.as_deref(),
     };
-    let style = ChartStyle {
-        scale: o
-            .pixel_ratio
-            .filter(|r| r.is_finite() && *r > 0.0)
-            .unwrap_or(1.0),
-        ..ChartStyle::default()
-    };
-    let backend = Canvas::new(canvas).ok_or_else(|| {
-        js_error(Error::Render {
-            reason: "the canvas has no 2D context".into(),
-        })
-    })?;
+    let (backend, style) = canvas_and_style(canvas, o.pixel_ratio)?;
     chart::draw_klipper_chart(&backend.into_drawing_area(), &chart, &style).map_err(js_error)
 }
 
