@@ -10,8 +10,9 @@
 //! chart is their legend (each row has its curve's colour), and the legend inside the chart
 //! names only the PSD curves.
 
-use super::{decimate, render_error, swatch, ChartStyle, Legend};
+use super::{decimate, render_error, swatch, ChartStyle, Legend, Linear};
 use crate::error::{Error, Result};
+use plotters::chart::DualCoordChartContext;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -101,8 +102,28 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
     chart: &KlipperChart<'_>,
     style: &ChartStyle,
 ) -> Result<()> {
+    check_lengths(chart)?;
+    area.fill(&WHITE).map_err(render_error)?;
     let f = chart.frequency_hz;
-    let n = f.len();
+    let f_hi = axis_end(chart);
+    let shown = f.partition_point(|&x| x <= f_hi).max(2).min(f.len());
+    let fs = &f[..shown];
+    let product = after_shaper(chart);
+    let threshold = acceptable_vibrations(fs, chart.psd_sum);
+    let curves = psd_curves(chart, shown, product.as_deref());
+    let scales = Scales::new(chart, shown, f_hi, &curves, &threshold);
+    let mut ctx = axes(area, chart, &scales, style)?;
+    let mut keys = draw_psds(&mut ctx, fs, &curves, &threshold, scales.top, style)?;
+    keys.push("acceptable vibrations", swatch(PSD_COLORS[5], style));
+    draw_shapers(&mut ctx, chart, fs, scales.v_top, style)?;
+    keys.draw_compact(&ctx, SeriesLabelPosition::UpperLeft, style)?;
+    area.present().map_err(render_error)?;
+    Ok(())
+}
+
+/// At least 2 frequencies, and every curve as long as the frequencies (the error names it).
+fn check_lengths(chart: &KlipperChart<'_>) -> Result<()> {
+    let n = chart.frequency_hz.len();
     if n < 2 {
         return Err(Error::invalid(
             "frequencyHz",
@@ -133,10 +154,15 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
     for (k, s) in chart.shapers.iter().enumerate() {
         check(&format!("shapers[{k}].values"), s.values)?;
     }
-    area.fill(&WHITE).map_err(render_error)?;
+    Ok(())
+}
 
-    let last = f[n - 1];
-    let f_hi = chart
+/// The upper end of the frequency axis: `max_hz` (default [`DEFAULT_MAX_HZ`]), at most the
+/// last bin.
+fn axis_end(chart: &KlipperChart<'_>) -> f64 {
+    let f = chart.frequency_hz;
+    let last = f[f.len() - 1];
+    chart
         .max_hz
         .filter(|m| m.is_finite() && *m > 0.0)
         .unwrap_or(DEFAULT_MAX_HZ)
@@ -144,11 +170,13 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
             last
         } else {
             1.0
-        });
-    let shown = f.partition_point(|&x| x <= f_hi).max(2).min(n);
-    let fs = &f[..shown];
-    // The PSD left after the selected shaper (Klipper: psd · best_shaper_vals).
-    let product: Option<Vec<f64>> = chart.after.map(|a| a.to_vec()).or_else(|| {
+        })
+}
+
+/// The PSD left after the selected shaper (Klipper: psd · best_shaper_vals): `after` if given,
+/// else the sum's PSD times the selected curve, if any.
+fn after_shaper(chart: &KlipperChart<'_>) -> Option<Vec<f64>> {
+    chart.after.map(|a| a.to_vec()).or_else(|| {
         chart.shapers.iter().find(|s| s.selected).map(|s| {
             chart
                 .psd_sum
@@ -157,19 +185,33 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
                 .map(|(p, v)| p * v)
                 .collect()
         })
-    });
-    // Klipper's "acceptable vibrations": max over f > 0 of PSD/f, times (f + 5)/33.3.
+    })
+}
+
+/// Klipper's "acceptable vibrations" at `fs`: max over f > 0 of PSD/f, times (f + 5)/33.3.
+fn acceptable_vibrations(fs: &[f64], psd_sum: &[f64]) -> Vec<f64> {
     let slope = fs
         .iter()
-        .zip(chart.psd_sum)
+        .zip(psd_sum)
         .filter(|(f, p)| **f > 0.0 && p.is_finite())
         .map(|(f, p)| p / f)
         .fold(0.0_f64, f64::max);
-    let threshold: Vec<f64> = fs.iter().map(|f| slope * (f + 5.0) / 33.3).collect();
+    fs.iter().map(|f| slope * (f + 5.0) / 33.3).collect()
+}
 
+/// A PSD curve: label, values over the shown frequencies, colour, stroke width.
+type PsdCurve<'a> = (&'a str, &'a [f64], RGBColor, f64);
+
+/// The PSD curves over the first `shown` frequencies: the sum, x, y, z where known, and the
+/// PSD after the selected shaper (`product`) if any.
+fn psd_curves<'a>(
+    chart: &KlipperChart<'a>,
+    shown: usize,
+    product: Option<&'a [f64]>,
+) -> Vec<PsdCurve<'a>> {
     // The sum wider than the axes: on one axis's test it is nearly that axis's curve, drawn
     // over it, and still shows as a purple border.
-    let mut curves: Vec<(&str, &[f64], RGBColor, f64)> =
+    let mut curves: Vec<PsdCurve<'a>> =
         vec![("X+Y+Z", &chart.psd_sum[..shown], PSD_COLORS[0], 3.0)];
     for (label, v, color) in [
         ("X", chart.psd_x, PSD_COLORS[1]),
@@ -180,40 +222,79 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
             curves.push((label, &v[..shown], color, 1.2));
         }
     }
-    if let Some(a) = &product {
+    if let Some(a) = product {
         curves.push(("after shaper", &a[..shown], PSD_COLORS[4], 1.5));
     }
-    let top = curves
-        .iter()
-        .flat_map(|c| c.1.iter().copied())
-        .chain(threshold.iter().copied())
-        .filter(|v| v.is_finite())
-        .fold(0.0_f64, f64::max)
-        .min(super::AXIS_LIMIT);
-    let top = if top > 0.0 { 1.05 * top } else { 1.0 };
-    let e = exponent(top);
-    let scale = 10f64.powi(e);
-    let v_top = chart
-        .shapers
-        .iter()
-        .flat_map(|s| s.values[..shown].iter().copied())
-        .filter(|v| v.is_finite())
-        .fold(1.0_f64, f64::max)
-        .min(10.0)
-        * 1.05;
+    curves
+}
 
-    let mut ctx = ChartBuilder::on(area)
-        .caption(
-            chart.title.unwrap_or("Frequency response and shapers"),
-            ("sans-serif", style.font(16.0)),
-        )
-        .margin(style.px(10.0))
-        .x_label_area_size(style.px(40.0))
-        .y_label_area_size(style.px(56.0))
-        .right_y_label_area_size(style.px(50.0))
-        .build_cartesian_2d(0.0..f_hi, 0.0..top)
-        .map_err(render_error)?
-        .set_secondary_coord(0.0..f_hi, 0.0..v_top);
+/// The ranges of the chart's axes.
+struct Scales {
+    /// Upper end of the frequency axis, Hz.
+    f_hi: f64,
+    /// Top of the PSD axis.
+    top: f64,
+    /// The exponent of 10 the PSD labels are divided by.
+    exponent: i32,
+    /// Top of the vibration-ratio axis.
+    v_top: f64,
+}
+
+impl Scales {
+    /// The axes' ranges for the PSD `curves` and `threshold` and the shapers' values over the
+    /// first `shown` frequencies.
+    fn new(
+        chart: &KlipperChart<'_>,
+        shown: usize,
+        f_hi: f64,
+        curves: &[PsdCurve<'_>],
+        threshold: &[f64],
+    ) -> Scales {
+        let top = curves
+            .iter()
+            .flat_map(|c| c.1.iter().copied())
+            .chain(threshold.iter().copied())
+            .filter(|v| v.is_finite())
+            .fold(0.0_f64, f64::max)
+            .min(super::AXIS_LIMIT);
+        let top = if top > 0.0 { 1.05 * top } else { 1.0 };
+        let v_top = chart
+            .shapers
+            .iter()
+            .flat_map(|s| s.values[..shown].iter().copied())
+            .filter(|v| v.is_finite())
+            .fold(1.0_f64, f64::max)
+            .min(10.0)
+            * 1.05;
+        Scales {
+            f_hi,
+            top,
+            exponent: exponent(top),
+            v_top,
+        }
+    }
+}
+
+/// The caption and both vertical axes: PSD on the left (labels in units of 10^exponent),
+/// the shapers' vibration ratio on the right.
+fn axes<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    chart: &KlipperChart<'_>,
+    scales: &Scales,
+    style: &ChartStyle,
+) -> Result<DualCoordChartContext<'a, DB, Linear, Linear>> {
+    let (f_hi, top, e) = (scales.f_hi, scales.top, scales.exponent);
+    let mut ctx = super::framed(
+        area,
+        chart.title.unwrap_or("Frequency response and shapers"),
+        56.0,
+        style,
+    )
+    .right_y_label_area_size(style.px(50.0))
+    .build_cartesian_2d(0.0..f_hi, 0.0..top)
+    .map_err(render_error)?
+    .set_secondary_coord(0.0..f_hi, 0.0..scales.v_top);
+    let scale = 10f64.powi(e);
     let y_label = |v: &f64| {
         let x = v / scale;
         let r = (x * 100.0).round() / 100.0;
@@ -224,15 +305,10 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
     } else {
         format!("power spectral density (×1e{e})")
     };
-    ctx.configure_mesh()
-        .x_desc("frequency (Hz)")
-        .y_desc(y_desc)
+    super::mesh(&mut ctx, "frequency (Hz)", y_desc, style)
         .y_label_formatter(&y_label)
         .x_label_formatter(&|f| format!("{f:.0}"))
-        .label_style(("sans-serif", style.font(12.0)))
-        .axis_desc_style(("sans-serif", style.font(13.0)))
         .bold_line_style(RGBColor(200, 200, 200))
-        .light_line_style(RGBColor(238, 238, 238))
         .draw()
         .map_err(render_error)?;
     ctx.configure_secondary_axes()
@@ -241,15 +317,27 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
         .axis_desc_style(("sans-serif", style.font(13.0)))
         .draw()
         .map_err(render_error)?;
+    Ok(ctx)
+}
 
+/// The acceptable-vibrations line, then the PSD curves (decimated, clipped to `top`); the
+/// legend of the curves.
+fn draw_psds<DB: DrawingBackend>(
+    ctx: &mut DualCoordChartContext<'_, DB, Linear, Linear>,
+    fs: &[f64],
+    curves: &[PsdCurve<'_>],
+    threshold: &[f64],
+    top: f64,
+    style: &ChartStyle,
+) -> Result<Legend> {
     let y_clip = |v: f64| super::clip(v, 0.0, top);
     ctx.draw_series(LineSeries::new(
-        fs.iter().zip(&threshold).map(|(&f, &v)| (f, y_clip(v))),
+        fs.iter().zip(threshold).map(|(&f, &v)| (f, y_clip(v))),
         PSD_COLORS[5].stroke_width(style.px(1.5)),
     ))
     .map_err(render_error)?;
     let mut keys = Legend::default();
-    for (label, values, color, width) in &curves {
+    for (label, values, color, width) in curves {
         let points = decimate(fs, values, BUCKETS);
         ctx.draw_series(LineSeries::new(
             points.into_iter().map(|(f, v)| (f, y_clip(v))),
@@ -258,16 +346,25 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
         .map_err(render_error)?;
         keys.push(*label, swatch(*color, style));
     }
-    keys.push("acceptable vibrations", swatch(PSD_COLORS[5], style));
+    Ok(keys)
+}
 
+/// The shapers' curves on the secondary axis, dashed (dotted for smooth shapers), the
+/// selected one thicker and last, over the others.
+fn draw_shapers<DB: DrawingBackend>(
+    ctx: &mut DualCoordChartContext<'_, DB, Linear, Linear>,
+    chart: &KlipperChart<'_>,
+    fs: &[f64],
+    v_top: f64,
+    style: &ChartStyle,
+) -> Result<()> {
     let v_clip = |v: f64| super::clip(v, 0.0, v_top);
-    // The selected shaper last, over the others.
     let mut order: Vec<usize> = (0..chart.shapers.len()).collect();
     order.sort_by_key(|&k| chart.shapers[k].selected);
     for k in order {
         let s = &chart.shapers[k];
         let color = s.color.unwrap_or(SHAPER_COLORS[k % SHAPER_COLORS.len()]);
-        let points: Vec<(f64, f64)> = decimate(fs, &s.values[..shown], BUCKETS)
+        let points: Vec<(f64, f64)> = decimate(fs, &s.values[..fs.len()], BUCKETS)
             .into_iter()
             .map(|(f, v)| (f, v_clip(v)))
             .collect();
@@ -284,7 +381,5 @@ pub fn draw_klipper_chart<DB: DrawingBackend>(
         ))
         .map_err(render_error)?;
     }
-    keys.draw_compact(&ctx, SeriesLabelPosition::UpperLeft, style)?;
-    area.present().map_err(render_error)?;
     Ok(())
 }

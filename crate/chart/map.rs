@@ -6,7 +6,7 @@
 //! rectangles rather than 80 000. The contour is traced by marching squares on the grid
 //! ([`contour_segments`]).
 
-use super::{render_error, ChartStyle, Key, Legend};
+use super::{render_error, ChartStyle, Key, Legend, Linear};
 use crate::error::{Error, Result};
 use crate::vibration::SensitivityMap;
 use plotters::coord::Shift;
@@ -311,20 +311,33 @@ pub fn draw_sensitivity_map_with<DB: DrawingBackend>(
 
     let (f, z) = (&map.frequency_hz, &map.damping);
     let (f_lo, f_hi, z_lo, z_hi) = (f[0], f[f.len() - 1], z[0], z[z.len() - 1]);
-    let mut chart = ChartBuilder::on(&main)
-        .caption(
-            "Residual vibration V(f, ζ)",
-            ("sans-serif", style.font(16.0)),
-        )
-        .margin(style.px(10.0))
-        .x_label_area_size(style.px(40.0))
-        .y_label_area_size(style.px(52.0))
+    let mut chart = super::framed(&main, "Residual vibration V(f, ζ)", 52.0, style)
         .build_cartesian_2d(f_lo..f_hi, z_lo..z_hi)
         .map_err(render_error)?;
     // The cells first, the axes and their labels after: a canvas' `putImageData` writes the
     // pixels at once, so whatever was drawn before it is rasterised inside the update (the
     // labels: most of the bitmap's cost); drawn after, they are rasterised with the frame.
     // The axes and labels lie in the label areas, beside the cells.
+    draw_cells(&mut chart, map, top, cells)?;
+    super::mesh(&mut chart, "frequency (Hz)", "damping ratio ζ", style)
+        .disable_mesh()
+        .draw()
+        .map_err(render_error)?;
+    draw_contour_and_modes(&mut chart, map, vtol, modes, style)?;
+    draw_color_bar(&bar, top, vtol, style)?;
+    area.present().map_err(render_error)?;
+    Ok(())
+}
+
+/// The map's cells on a scale topped at `top`, as rectangles or as one bitmap (`cells`).
+fn draw_cells<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Linear>,
+    map: &SensitivityMap,
+    top: f64,
+    cells: MapCells,
+) -> Result<()> {
+    let (f, z) = (&map.frequency_hz, &map.damping);
+    let (f_lo, z_lo) = (f[0], z[0]);
     let (fe, ze) = (cell_edges(f), cell_edges(z));
     match cells {
         MapCells::Rectangles => {
@@ -366,17 +379,21 @@ pub fn draw_sensitivity_map_with<DB: DrawingBackend>(
                 .map_err(render_error)?;
         }
     }
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("frequency (Hz)")
-        .y_desc("damping ratio ζ")
-        .label_style(("sans-serif", style.font(12.0)))
-        .axis_desc_style(("sans-serif", style.font(13.0)))
-        .draw()
-        .map_err(render_error)?;
-    let mut keys = Legend::default();
+    Ok(())
+}
 
+/// Over the cells: the contour V = `vtol` (with its legend, if any) and a cross at each mode
+/// inside the map.
+fn draw_contour_and_modes<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Linear>,
+    map: &SensitivityMap,
+    vtol: Option<f64>,
+    modes: &[(f64, f64)],
+    style: &ChartStyle,
+) -> Result<()> {
+    let (f, z) = (&map.frequency_hz, &map.damping);
+    let (f_lo, f_hi, z_lo, z_hi) = (f[0], f[f.len() - 1], z[0], z[z.len() - 1]);
+    let mut keys = Legend::default();
     if let Some(vtol) = vtol {
         let line = CONTOUR_COLOR.stroke_width(style.px(2.0));
         chart
@@ -399,12 +416,21 @@ pub fn draw_sensitivity_map_with<DB: DrawingBackend>(
         )
         .map_err(render_error)?;
     if vtol.is_some() {
-        keys.draw_default(&chart, SeriesLabelPosition::UpperRight, style)?;
+        keys.draw_default(chart, SeriesLabelPosition::UpperRight, style)?;
     }
+    Ok(())
+}
 
-    // Colour bar: the levels stacked from 0 to `top`, labelled in %.
+/// The colour bar in `bar`: the levels stacked from 0 to `top`, labelled in %, with `vtol`
+/// marked.
+fn draw_color_bar<DB: DrawingBackend>(
+    bar: &DrawingArea<DB, Shift>,
+    top: f64,
+    vtol: Option<f64>,
+    style: &ChartStyle,
+) -> Result<()> {
     let top_pct = top * 100.0;
-    let mut bar_chart = ChartBuilder::on(&bar)
+    let mut bar_chart = ChartBuilder::on(bar)
         .margin_top(style.px(36.0))
         .margin_bottom(style.px(50.0))
         .margin_right(style.px(4.0))
@@ -435,6 +461,5 @@ pub fn draw_sensitivity_map_with<DB: DrawingBackend>(
             ))
             .map_err(render_error)?;
     }
-    area.present().map_err(render_error)?;
     Ok(())
 }

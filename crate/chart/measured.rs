@@ -1,7 +1,7 @@
 //! The measured spectrum: a power spectral density in dB against frequency, with the detected
 //! peaks (identified modes) marked and labelled.
 
-use super::{render_error, ChartStyle};
+use super::{render_error, ChartStyle, Linear};
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -45,7 +45,47 @@ pub fn draw_measured_spectrum<DB: DrawingBackend>(
         .min(last)
         .max(1e-9);
     let f_lo = frequency_hz[0].min(f_hi * 0.999);
-    let db = |p: f64| 10.0 * p.max(1e-300).log10();
+    let points = drawn_points(frequency_hz, psd, f_hi);
+    let (y_lo, y_hi) = db_range(&points);
+    // The plot's vertical range: a margin below, twice as much above for the peaks' labels.
+    let pad = 0.08 * (y_hi - y_lo).max(1.0);
+    let (bottom, top) = (y_lo - pad, y_hi + 2.0 * pad);
+    let mut chart = super::framed(area, titles.0, 56.0, style)
+        .build_cartesian_2d(f_lo..f_hi, bottom..top)
+        .map_err(render_error)?;
+    super::mesh(&mut chart, "frequency (Hz)", titles.1, style)
+        .draw()
+        .map_err(render_error)?;
+    let color = style.color(0);
+    chart
+        .draw_series(LineSeries::new(
+            points.iter().map(|&(f, v)| (f, v.max(bottom))),
+            color.stroke_width(style.px(1.5)),
+        ))
+        .map_err(render_error)?;
+    let level = |f: f64| {
+        let i = frequency_hz.partition_point(|&x| x < f).min(psd.len() - 1);
+        let lo = i.saturating_sub(2);
+        let hi = (i + 3).min(psd.len());
+        psd[lo..hi].iter().copied().fold(0.0, f64::max)
+    };
+    for (f, label) in peaks.iter().filter(|(f, _)| (f_lo..=f_hi).contains(f)) {
+        let y = db(level(*f)).max(bottom);
+        let label_y = y_hi + 1.5 * pad;
+        draw_peak(&mut chart, *f, y, (bottom, top), label, label_y, style)?;
+    }
+    area.present().map_err(render_error)?;
+    Ok(())
+}
+
+/// A PSD in dB.
+fn db(p: f64) -> f64 {
+    10.0 * p.max(1e-300).log10()
+}
+
+/// The points drawn, (frequency, dB) up to `f_hi`: at most [`MAX_DRAWN_POINTS`], each the
+/// largest of its bucket (at the bucket's middle frequency), so no peak is lost.
+fn drawn_points(frequency_hz: &[f64], psd: &[f64], f_hi: f64) -> Vec<(f64, f64)> {
     let shown: Vec<(f64, f64)> = frequency_hz
         .iter()
         .zip(psd)
@@ -53,7 +93,7 @@ pub fn draw_measured_spectrum<DB: DrawingBackend>(
         .map(|(&f, &p)| (f, db(p)))
         .collect();
     let bucket = shown.len().div_ceil(MAX_DRAWN_POINTS).max(1);
-    let points: Vec<(f64, f64)> = shown
+    shown
         .chunks(bucket)
         .filter_map(|c| {
             c.iter()
@@ -61,7 +101,12 @@ pub fn draw_measured_spectrum<DB: DrawingBackend>(
                 .max_by(|a, b| a.1.total_cmp(&b.1))
                 .map(|(_, v)| (c[c.len() / 2].0, v))
         })
-        .collect();
+        .collect()
+}
+
+/// The dB range of `points`, at most 120 dB below the top (so a zero bin does not flatten
+/// the chart); (−1, 1) without points.
+fn db_range(points: &[(f64, f64)]) -> (f64, f64) {
     let (mut y_lo, mut y_hi) = points
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
@@ -70,62 +115,41 @@ pub fn draw_measured_spectrum<DB: DrawingBackend>(
     if !(y_lo.is_finite() && y_hi.is_finite()) {
         (y_lo, y_hi) = (-1.0, 1.0);
     }
-    // At most 120 dB below the top, so a zero bin does not flatten the chart.
     y_lo = y_lo.max(y_hi - 120.0);
-    let pad = 0.08 * (y_hi - y_lo).max(1.0);
-    let mut chart = ChartBuilder::on(area)
-        .caption(titles.0, ("sans-serif", style.font(16.0)))
-        .margin(style.px(10.0))
-        .x_label_area_size(style.px(40.0))
-        .y_label_area_size(style.px(56.0))
-        .build_cartesian_2d(f_lo..f_hi, (y_lo - pad)..(y_hi + 2.0 * pad))
-        .map_err(render_error)?;
-    chart
-        .configure_mesh()
-        .x_desc("frequency (Hz)")
-        .y_desc(titles.1)
-        .label_style(("sans-serif", style.font(12.0)))
-        .axis_desc_style(("sans-serif", style.font(13.0)))
-        .light_line_style(RGBColor(238, 238, 238))
-        .draw()
-        .map_err(render_error)?;
-    let color = style.color(0);
+    (y_lo, y_hi)
+}
+
+/// A peak at `f`: a vertical line over `span` (bottom, top), a ring at level `y` (dB) and
+/// `label` at height `label_y`.
+fn draw_peak<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Linear>,
+    f: f64,
+    y: f64,
+    span: (f64, f64),
+    label: &str,
+    label_y: f64,
+    style: &ChartStyle,
+) -> Result<()> {
+    let mark = RGBColor(213, 94, 0);
     chart
         .draw_series(LineSeries::new(
-            points.iter().map(|&(f, v)| (f, v.max(y_lo - pad))),
-            color.stroke_width(style.px(1.5)),
+            [(f, span.0), (f, span.1)],
+            mark.mix(0.5).stroke_width(style.px(1.0)),
         ))
         .map_err(render_error)?;
-    let mark = RGBColor(213, 94, 0);
-    let level = |f: f64| {
-        let i = frequency_hz.partition_point(|&x| x < f).min(psd.len() - 1);
-        let lo = i.saturating_sub(2);
-        let hi = (i + 3).min(psd.len());
-        psd[lo..hi].iter().copied().fold(0.0, f64::max)
-    };
-    for (f, label) in peaks.iter().filter(|(f, _)| (f_lo..=f_hi).contains(f)) {
-        let y = db(level(*f)).max(y_lo - pad);
-        chart
-            .draw_series(LineSeries::new(
-                [(*f, y_lo - pad), (*f, y_hi + 2.0 * pad)],
-                mark.mix(0.5).stroke_width(style.px(1.0)),
-            ))
-            .map_err(render_error)?;
-        chart
-            .draw_series(std::iter::once(Circle::new(
-                (*f, y),
-                style.px(5.0),
-                mark.stroke_width(style.px(2.0)),
-            )))
-            .map_err(render_error)?;
-        chart
-            .draw_series(std::iter::once(Text::new(
-                label.clone(),
-                (*f, y_hi + 1.5 * pad),
-                ("sans-serif", style.font(12.0)).into_font().color(&mark),
-            )))
-            .map_err(render_error)?;
-    }
-    area.present().map_err(render_error)?;
+    chart
+        .draw_series(std::iter::once(Circle::new(
+            (f, y),
+            style.px(5.0),
+            mark.stroke_width(style.px(2.0)),
+        )))
+        .map_err(render_error)?;
+    chart
+        .draw_series(std::iter::once(Text::new(
+            label.to_string(),
+            (f, label_y),
+            ("sans-serif", style.font(12.0)).into_font().color(&mark),
+        )))
+        .map_err(render_error)?;
     Ok(())
 }

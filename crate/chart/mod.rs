@@ -14,6 +14,7 @@ pub mod sensitivity;
 pub mod spectrum;
 
 use crate::error::Error;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 pub use command::draw_command;
@@ -114,6 +115,47 @@ pub(crate) fn render_error<E: std::fmt::Debug>(e: E) -> Error {
     Error::Render {
         reason: format!("{e:?}"),
     }
+}
+
+/// Colour of the light grid lines of most charts.
+pub(crate) const LIGHT_GRID: RGBColor = RGBColor(238, 238, 238);
+
+/// Linear coordinates on both axes, the charts' usual.
+pub(crate) type Linear = Cartesian2d<RangedCoordf64, RangedCoordf64>;
+
+/// The frame most charts share: `caption` at font 16, a 10 px margin, a 40 px x-label area
+/// and a `y_labels` px y-label area (all scaled). Set more on it before building the axes.
+pub(crate) fn framed<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, plotters::coord::Shift>,
+    caption: impl AsRef<str>,
+    y_labels: f64,
+    style: &ChartStyle,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(caption, ("sans-serif", style.font(16.0)))
+        .margin(style.px(10.0))
+        .x_label_area_size(style.px(40.0))
+        .y_label_area_size(style.px(y_labels));
+    builder
+}
+
+/// The axes most charts share: the descriptions `x_desc` and `y_desc`, tick labels at font 12
+/// and descriptions at font 13 (scaled), grid lines in [`LIGHT_GRID`]. Set more on it, then
+/// `draw()`.
+pub(crate) fn mesh<'a, 'b, DB: DrawingBackend>(
+    chart: &'b mut ChartContext<'a, DB, Linear>,
+    x_desc: &str,
+    y_desc: impl Into<String>,
+    style: &ChartStyle,
+) -> plotters::chart::MeshStyle<'a, 'b, RangedCoordf64, RangedCoordf64, DB> {
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style(("sans-serif", style.font(12.0)))
+        .axis_desc_style(("sans-serif", style.font(13.0)))
+        .light_line_style(LIGHT_GRID);
+    mesh
 }
 
 /// Colour of the unshaped reference in the simulation, command and spectrum charts.

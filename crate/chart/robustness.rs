@@ -5,7 +5,7 @@
 //! Family names are placed beside their points, moved above, below or to the left when they
 //! would overlap a name already placed (a greedy search in pixel space).
 
-use super::{render_error, ChartStyle, Key, Legend};
+use super::{render_error, ChartStyle, Key, Legend, Linear};
 use crate::error::Result;
 use crate::robustness::RobustnessRow;
 use plotters::coord::Shift;
@@ -39,6 +39,56 @@ pub fn draw_robustness<DB: DrawingBackend>(
     style: &ChartStyle,
 ) -> Result<()> {
     area.fill(&WHITE).map_err(render_error)?;
+    let mut chart = axes(area, families, marks, vtol, style)?;
+    let dot = style.px(3.5);
+    chart
+        .draw_series(
+            families
+                .iter()
+                .filter(valid)
+                .map(|r| Circle::new((r.duration_periods, r.insensitivity), dot, GREY.filled())),
+        )
+        .map_err(render_error)?;
+    let mut keys = Legend::default();
+    keys.push(
+        "families (for mode 1)",
+        Key::Dot {
+            dx: 8,
+            radius: dot as i32,
+            style: GREY.filled(),
+        },
+    );
+    let font_px = style.font(11.0);
+    let font = ("sans-serif", font_px)
+        .into_font()
+        .color(&RGBColor(70, 70, 70));
+    for (text, pos) in place_names(&chart, families, marks, dot as i32 + 1, font_px, style) {
+        area.draw(&Text::new(text, pos, font.clone()))
+            .map_err(render_error)?;
+    }
+    draw_marks(&mut chart, marks, &mut keys, style)?;
+    // Upper left: short, very insensitive shapers do not exist, so no point hides there.
+    keys.draw_compact(&chart, SeriesLabelPosition::UpperLeft, style)?;
+    area.present().map_err(render_error)?;
+    Ok(())
+}
+
+/// Colour of the families' points.
+const GREY: RGBColor = RGBColor(120, 120, 120);
+
+/// A family's point is drawable.
+fn valid(r: &&RobustnessRow) -> bool {
+    r.duration_periods.is_finite() && r.insensitivity.is_finite()
+}
+
+/// The caption and axes, spanning every finite point of `families` and `marks` with a margin.
+fn axes<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    families: &[RobustnessRow],
+    marks: &[RobustnessMark<'_>],
+    vtol: f64,
+    style: &ChartStyle,
+) -> Result<ChartContext<'a, DB, Linear>> {
     let points = || {
         families
             .iter()
@@ -50,59 +100,40 @@ pub fn draw_robustness<DB: DrawingBackend>(
     let i_max = points().map(|p| p.1).fold(0.0_f64, f64::max);
     let d_max = if d_max > 0.0 { d_max * 1.12 } else { 1.0 };
     let i_max = if i_max > 0.0 { i_max * 1.15 } else { 1.0 };
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!(
-                "Robustness vs duration (I at Vtol {} %)",
-                (vtol * 100.0 * 1000.0).round() / 1000.0
-            ),
-            ("sans-serif", style.font(16.0)),
-        )
-        .margin(style.px(10.0))
+    let caption = format!(
+        "Robustness vs duration (I at Vtol {} %)",
+        (vtol * 100.0 * 1000.0).round() / 1000.0
+    );
+    let mut chart = super::framed(area, caption, 60.0, style)
         .margin_right(style.px(16.0))
-        .x_label_area_size(style.px(40.0))
-        .y_label_area_size(style.px(60.0))
         .build_cartesian_2d(0.0..d_max, 0.0..i_max)
         .map_err(render_error)?;
-    chart
-        .configure_mesh()
-        .x_desc("duration (damped periods of mode 1)")
-        .y_desc("insensitivity I(Vtol)")
-        .label_style(("sans-serif", style.font(12.0)))
-        .axis_desc_style(("sans-serif", style.font(13.0)))
-        .light_line_style(RGBColor(238, 238, 238))
-        .draw()
-        .map_err(render_error)?;
-    let grey = RGBColor(120, 120, 120);
-    let dot = style.px(3.5);
-    let valid = |r: &&RobustnessRow| r.duration_periods.is_finite() && r.insensitivity.is_finite();
-    chart
-        .draw_series(
-            families
-                .iter()
-                .filter(valid)
-                .map(|r| Circle::new((r.duration_periods, r.insensitivity), dot, grey.filled())),
-        )
-        .map_err(render_error)?;
-    let mut keys = Legend::default();
-    keys.push(
-        "families (for mode 1)",
-        Key::Dot {
-            dx: 8,
-            radius: dot as i32,
-            style: grey.filled(),
-        },
-    );
-    // Names, avoiding each other, the plot's edges and the points.
-    let font_px = style.font(11.0);
-    let font = ("sans-serif", font_px)
-        .into_font()
-        .color(&RGBColor(70, 70, 70));
+    super::mesh(
+        &mut chart,
+        "duration (damped periods of mode 1)",
+        "insensitivity I(Vtol)",
+        style,
+    )
+    .draw()
+    .map_err(render_error)?;
+    Ok(chart)
+}
+
+/// Where the families' names go (text, top-left pixel), avoiding each other, the plot's
+/// edges, the points (of radius `r` pixels) and the marks' rings; a name that fits nowhere is
+/// left out.
+fn place_names<DB: DrawingBackend>(
+    chart: &ChartContext<'_, DB, Linear>,
+    families: &[RobustnessRow],
+    marks: &[RobustnessMark<'_>],
+    r: i32,
+    font_px: f64,
+    style: &ChartStyle,
+) -> Vec<(String, (i32, i32))> {
     let (x_range, y_range) = (chart.x_range(), chart.y_range());
     let to_px = |p: (f64, f64)| chart.backend_coord(&p);
     let (left, top) = to_px((x_range.start, y_range.end));
     let (right, bottom) = to_px((x_range.end, y_range.start));
-    let r = dot as i32 + 1;
     let mut taken: Vec<Box2> = families
         .iter()
         .filter(valid)
@@ -150,10 +181,17 @@ pub fn draw_robustness<DB: DrawingBackend>(
             labels.push((row.title.clone(), (lx, ly)));
         }
     }
-    for (text, pos) in labels {
-        area.draw(&Text::new(text, pos, font.clone()))
-            .map_err(render_error)?;
-    }
+    labels
+}
+
+/// The compared shapers' rings in the series colours (growing, so coinciding ones stay
+/// visible), each with a legend entry.
+fn draw_marks<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Linear>,
+    marks: &[RobustnessMark<'_>],
+    keys: &mut Legend,
+    style: &ChartStyle,
+) -> Result<()> {
     for (k, m) in marks.iter().enumerate() {
         if !(m.duration_periods.is_finite() && m.insensitivity.is_finite()) {
             continue;
@@ -177,8 +215,5 @@ pub fn draw_robustness<DB: DrawingBackend>(
             },
         );
     }
-    // Upper left: short, very insensitive shapers do not exist, so no point hides there.
-    keys.draw_compact(&chart, SeriesLabelPosition::UpperLeft, style)?;
-    area.present().map_err(render_error)?;
     Ok(())
 }

@@ -3,7 +3,7 @@
 //! modes by dashed ones — a shaped command should have (almost) no content at the modes
 //! (Veciana & Cardona 2011 §2).
 
-use super::{render_error, swatch, ChartStyle, Legend, UNSHAPED_COLOR};
+use super::{render_error, swatch, ChartStyle, Legend, Linear, UNSHAPED_COLOR};
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -42,27 +42,51 @@ pub fn draw_spectrum<DB: DrawingBackend>(
         .filter(|v| v.is_finite())
         .fold(0.0_f64, f64::max);
     let top = if top > 0.0 { top * 1.08 } else { 1.0 };
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            "Command spectrum |U(f)| (velocity)",
-            ("sans-serif", style.font(16.0)),
-        )
-        .margin(style.px(10.0))
+    let mut chart = super::framed(area, "Command spectrum |U(f)| (velocity)", 60.0, style)
         .margin_right(style.px(14.0))
-        .x_label_area_size(style.px(40.0))
-        .y_label_area_size(style.px(60.0))
         .build_cartesian_2d(f_lo..f_hi, 0.0..top)
         .map_err(render_error)?;
-    chart
-        .configure_mesh()
-        .x_desc("frequency (Hz)")
-        .y_desc("|U(f)|")
-        .label_style(("sans-serif", style.font(12.0)))
-        .axis_desc_style(("sans-serif", style.font(13.0)))
-        .light_line_style(RGBColor(238, 238, 238))
+    super::mesh(&mut chart, "frequency (Hz)", "|U(f)|", style)
         .draw()
         .map_err(render_error)?;
     let mut keys = Legend::default();
+    draw_mode_markers(&mut chart, modes_hz, actual_hz, &mut keys, style)?;
+    let all = std::iter::once(("unshaped", unshaped, UNSHAPED_COLOR)).chain(
+        shaped
+            .iter()
+            .enumerate()
+            .map(|(k, (l, m))| (*l, *m, style.color(k))),
+    );
+    for (label, magnitude, color) in all {
+        chart
+            .draw_series(LineSeries::new(
+                frequency_hz
+                    .iter()
+                    .zip(magnitude)
+                    .filter(|(_, v)| v.is_finite())
+                    .map(|(&f, &v)| (f, v)),
+                color.stroke_width(style.px(if label == "unshaped" { 1.5 } else { 2.0 })),
+            ))
+            .map_err(render_error)?;
+        keys.push(label, swatch(color, style));
+    }
+    keys.draw_compact(&chart, SeriesLabelPosition::UpperRight, style)?;
+    area.present().map_err(render_error)?;
+    Ok(())
+}
+
+/// Full-height markers within the frequency axis: solid grey at `modes_hz` (the model),
+/// dashed red at each of `actual_hz` that is not a model mode; one legend entry for each kind
+/// drawn.
+fn draw_mode_markers<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Linear>,
+    modes_hz: &[f64],
+    actual_hz: &[f64],
+    keys: &mut Legend,
+    style: &ChartStyle,
+) -> Result<()> {
+    let (x_range, y_range) = (chart.x_range(), chart.y_range());
+    let (f_lo, f_hi, top) = (x_range.start, x_range.end, y_range.end);
     let marker = RGBColor(90, 90, 90);
     let inside = |f: &&f64| (f_lo..=f_hi).contains(*f);
     let mut first = true;
@@ -93,26 +117,5 @@ pub fn draw_spectrum<DB: DrawingBackend>(
             keys.push("actual modes", swatch(actual, style));
         }
     }
-    let all = std::iter::once(("unshaped", unshaped, UNSHAPED_COLOR)).chain(
-        shaped
-            .iter()
-            .enumerate()
-            .map(|(k, (l, m))| (*l, *m, style.color(k))),
-    );
-    for (label, magnitude, color) in all {
-        chart
-            .draw_series(LineSeries::new(
-                frequency_hz
-                    .iter()
-                    .zip(magnitude)
-                    .filter(|(_, v)| v.is_finite())
-                    .map(|(&f, &v)| (f, v)),
-                color.stroke_width(style.px(if label == "unshaped" { 1.5 } else { 2.0 })),
-            ))
-            .map_err(render_error)?;
-        keys.push(label, swatch(color, style));
-    }
-    keys.draw_compact(&chart, SeriesLabelPosition::UpperRight, style)?;
-    area.present().map_err(render_error)?;
     Ok(())
 }
