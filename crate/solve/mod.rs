@@ -313,74 +313,9 @@ pub const MAX_BANDS: usize = crate::mode::MAX_MODES;
 
 impl NormalizedProblem {
     fn new(p: &Problem) -> Result<Self> {
-        // Sizes first, so nothing below (or in the programs) grows without bound.
-        crate::error::count("modes", p.zeros.len(), 0, MAX_ZEROS)?;
-        crate::error::count("sampleFrequenciesHz", p.limits.len(), 0, MAX_LIMITS)?;
-        crate::error::count("bands", p.bands.len(), 0, MAX_BANDS)?;
-        for z in &p.zeros {
-            if z.derivatives > MAX_ZERO_DERIVATIVES {
-                return Err(Error::TooLarge {
-                    field: "derivatives".into(),
-                    value: f64::from(z.derivatives),
-                    limit: f64::from(MAX_ZERO_DERIVATIVES),
-                });
-            }
-        }
-        finite("amplitudeMin", p.amplitude_min)?;
-        finite("amplitudeMax", p.amplitude_max)?;
-        if p.amplitude_max <= 0.0 || p.amplitude_min >= p.amplitude_max || p.amplitude_min > 1.0 {
-            return Err(Error::invalid(
-                "amplitudeMax",
-                format!(
-                    "need amplitudeMin < amplitudeMax, amplitudeMax > 0 and amplitudeMin ≤ 1, got \
-                     [{}, {}]",
-                    p.amplitude_min, p.amplitude_max
-                ),
-            ));
-        }
-        let mut f_ref: f64 = 0.0;
-        let mut f_min = f64::INFINITY;
-        for (i, z) in p.zeros.iter().enumerate() {
-            check_frequency(&format!("modes[{i}].frequencyHz"), z.frequency_hz)?;
-            check_damping(&format!("modes[{i}].damping"), z.damping)?;
-            f_ref = f_ref.max(z.frequency_hz);
-            f_min = f_min.min(z.frequency_hz);
-        }
-        for l in &p.limits {
-            check_frequency("sampleFrequenciesHz", l.frequency_hz)?;
-            check_damping("damping", l.damping)?;
-            if !(l.vtol > 0.0 && l.vtol < 1.0) {
-                return Err(Error::invalid(
-                    "vtol",
-                    format!("must lie in (0, 1), got {}", l.vtol),
-                ));
-            }
-            f_ref = f_ref.max(l.frequency_hz);
-            f_min = f_min.min(l.frequency_hz);
-        }
-        for b in &p.bands {
-            check_frequency("bandHz[0]", b.from_hz)?;
-            check_frequency("bandHz[1]", b.to_hz)?;
-            if b.to_hz < b.from_hz {
-                return Err(Error::invalid("bandHz", "the band's ends are reversed"));
-            }
-            check_damping("dampingRange[0]", b.damping_from)?;
-            check_damping("dampingRange[1]", b.damping_to)?;
-            if b.damping_to < b.damping_from {
-                return Err(Error::invalid(
-                    "dampingRange",
-                    "the range's ends are reversed",
-                ));
-            }
-            f_ref = f_ref.max(b.to_hz);
-            f_min = f_min.min(b.from_hz);
-        }
-        if f_ref <= 0.0 {
-            return Err(Error::invalid(
-                "modes",
-                "the design has no constraint (no mode, sample or band)",
-            ));
-        }
+        check_sizes(p)?;
+        check_amplitudes(p)?;
+        let (f_ref, f_min) = frequency_span(p)?;
         let w = |f: f64| 2.0 * PI * f / f_ref;
         let max_duration = match p.max_duration {
             Some(d) => {
@@ -446,6 +381,90 @@ impl NormalizedProblem {
     }
 }
 
+/// Sizes first, so nothing below (or in the programs) grows without bound.
+fn check_sizes(p: &Problem) -> Result<()> {
+    crate::error::count("modes", p.zeros.len(), 0, MAX_ZEROS)?;
+    crate::error::count("sampleFrequenciesHz", p.limits.len(), 0, MAX_LIMITS)?;
+    crate::error::count("bands", p.bands.len(), 0, MAX_BANDS)?;
+    for z in &p.zeros {
+        if z.derivatives > MAX_ZERO_DERIVATIVES {
+            return Err(Error::TooLarge {
+                field: "derivatives".into(),
+                value: f64::from(z.derivatives),
+                limit: f64::from(MAX_ZERO_DERIVATIVES),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The amplitude bounds: finite, amplitudeMin < amplitudeMax, amplitudeMax > 0 and
+/// amplitudeMin ≤ 1 (else Σ A = 1 is out of reach).
+fn check_amplitudes(p: &Problem) -> Result<()> {
+    finite("amplitudeMin", p.amplitude_min)?;
+    finite("amplitudeMax", p.amplitude_max)?;
+    if p.amplitude_max <= 0.0 || p.amplitude_min >= p.amplitude_max || p.amplitude_min > 1.0 {
+        return Err(Error::invalid(
+            "amplitudeMax",
+            format!(
+                "need amplitudeMin < amplitudeMax, amplitudeMax > 0 and amplitudeMin ≤ 1, got \
+                 [{}, {}]",
+                p.amplitude_min, p.amplitude_max
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks every constraint's frequencies, damping ratios and tolerances, and returns the
+/// highest and lowest constrained frequencies (Hz); an error if there is no constraint.
+fn frequency_span(p: &Problem) -> Result<(f64, f64)> {
+    let mut f_ref: f64 = 0.0;
+    let mut f_min = f64::INFINITY;
+    for (i, z) in p.zeros.iter().enumerate() {
+        check_frequency(&format!("modes[{i}].frequencyHz"), z.frequency_hz)?;
+        check_damping(&format!("modes[{i}].damping"), z.damping)?;
+        f_ref = f_ref.max(z.frequency_hz);
+        f_min = f_min.min(z.frequency_hz);
+    }
+    for l in &p.limits {
+        check_frequency("sampleFrequenciesHz", l.frequency_hz)?;
+        check_damping("damping", l.damping)?;
+        if !(l.vtol > 0.0 && l.vtol < 1.0) {
+            return Err(Error::invalid(
+                "vtol",
+                format!("must lie in (0, 1), got {}", l.vtol),
+            ));
+        }
+        f_ref = f_ref.max(l.frequency_hz);
+        f_min = f_min.min(l.frequency_hz);
+    }
+    for b in &p.bands {
+        check_frequency("bandHz[0]", b.from_hz)?;
+        check_frequency("bandHz[1]", b.to_hz)?;
+        if b.to_hz < b.from_hz {
+            return Err(Error::invalid("bandHz", "the band's ends are reversed"));
+        }
+        check_damping("dampingRange[0]", b.damping_from)?;
+        check_damping("dampingRange[1]", b.damping_to)?;
+        if b.damping_to < b.damping_from {
+            return Err(Error::invalid(
+                "dampingRange",
+                "the range's ends are reversed",
+            ));
+        }
+        f_ref = f_ref.max(b.to_hz);
+        f_min = f_min.min(b.from_hz);
+    }
+    if f_ref <= 0.0 {
+        return Err(Error::invalid(
+            "modes",
+            "the design has no constraint (no mode, sample or band)",
+        ));
+    }
+    Ok((f_ref, f_min))
+}
+
 // ---------------------------------------------------------------------------------------------
 // The driver
 
@@ -467,7 +486,8 @@ fn shortest(_: NormalizedProblem) -> Result<Design> {
     Err(Error::solver_left_out())
 }
 
-/// [`minimum_duration`] on the normalised problem.
+/// [`minimum_duration`] on the normalised problem: rounds of the exchange loop (grid program,
+/// polish, check over the bands), each adding the points where the last design broke a band.
 #[cfg(feature = "solver")]
 fn shortest(norm: NormalizedProblem) -> Result<Design> {
     let mut samples: Vec<NormalizedLimit> = norm.limits.clone();
@@ -476,7 +496,7 @@ fn shortest(norm: NormalizedProblem) -> Result<Design> {
     }
     let mut programs = 0;
     for round in 1..=MAX_EXCHANGE_ROUNDS {
-        let mut grid = shortest_on_grid(&norm, &samples, None, &mut programs)?;
+        let grid = shortest_on_grid(&norm, &samples, None, &mut programs)?;
         // Neighbouring grid impulses that add up beyond the amplitude bounds mean the grid is
         // emulating impulses the bounds forbid (binding bounds, e.g. negative shapers): no
         // few-impulse structure to polish, and finer grids only emulate more closely.
@@ -484,7 +504,7 @@ fn shortest(norm: NormalizedProblem) -> Result<Design> {
             c.amplitude > norm.amplitude_max * (1.0 + 1e-3)
                 || c.amplitude < norm.amplitude_min * (1.0 + 1e-3)
         });
-        let mut polished = if beyond_bounds {
+        let polished = if beyond_bounds {
             None
         } else {
             polish::polish(&norm, &grid)
@@ -492,60 +512,18 @@ fn shortest(norm: NormalizedProblem) -> Result<Design> {
         if polished.is_none() && round < MAX_EXCHANGE_ROUNDS {
             // The polish failed. If the grid solution itself exceeds a band between the samples,
             // the samples are too few to fix the structure: add its maxima and start again.
-            let raw: Vec<Impulse> = grid
-                .times
-                .iter()
-                .zip(&grid.amplitudes)
-                .map(|(&time, &amplitude)| Impulse { time, amplitude })
-                .collect();
-            let violations = scan::check(&norm, &raw).violations;
+            let violations = grid_violations(&norm, &grid);
             if !violations.is_empty() {
                 samples.extend(violations);
                 continue;
             }
         }
-        // If the polish still fails (impulses too close for the grid to resolve, a poor
-        // start), refine the grid around the impulses the solution uses and try again.
-        for _ in 0..MAX_REFINEMENTS {
-            if polished.is_some() || beyond_bounds {
-                break;
-            }
-            let pattern = refine_pattern(&grid);
-            grid = shortest_on_grid(
-                &norm,
-                &samples,
-                Some((&pattern, grid.duration)),
-                &mut programs,
-            )?;
-            polished = polish::polish(&norm, &grid);
-        }
-        // The polish and the fallback's projection solve equalities and may step outside the
-        // amplitude bounds (the convergence grid found direct ZVDD designs with amplitudes down
-        // to −0.008 at amplitudeMin = 0): a result outside them is not accepted.
-        let (mut impulses, polished) = match polished.filter(|p| within_bounds(&norm, p)) {
-            Some(imps) => (imps, true),
-            None => (fallback(&norm, &samples, &grid, &mut programs)?, false),
+        let (grid, polished) = if beyond_bounds {
+            (grid, polished)
+        } else {
+            refine(&norm, &samples, grid, polished, &mut programs)?
         };
-        // Σ A = 1 only to the polish's Newton tolerance (the convergence grid found SI for four
-        // modes at 1 + 1.8e-8): rescale to Σ A = 1 to rounding. Everything below (the bounds,
-        // V ≤ Vtol, the zero moments) is checked on the rescaled amplitudes.
-        renormalize(&mut impulses);
-        if !within_bounds(&norm, &impulses) {
-            let worst = impulses
-                .iter()
-                .map(|i| i.amplitude)
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), a| {
-                    (lo.min(a), hi.max(a))
-                });
-            return Err(Error::Infeasible {
-                reason: format!(
-                    "the design's amplitudes ({:.6} … {:.6}) leave the bounds [{}, {}] when its \
-                     constraints are solved exactly: the problem is numerically degenerate here \
-                     (modes very close, many derivatives); widen the bounds or drop a derivative",
-                    worst.0, worst.1, norm.amplitude_min, norm.amplitude_max
-                ),
-            });
-        }
+        let (impulses, polished) = accepted(&norm, &samples, &grid, polished, &mut programs)?;
         let report = scan::check(&norm, &impulses);
         if report.worst_limit > 1.0 + CHECK_TOLERANCE || report.worst_moment > ZERO_TOLERANCE {
             // Not something more samples can fix: the numbers are at their limits.
@@ -581,6 +559,81 @@ fn shortest(norm: NormalizedProblem) -> Result<Design> {
              {MAX_EXCHANGE_ROUNDS} rounds of refinement"
         ),
     })
+}
+
+/// Where the grid solution itself exceeds a band between the samples (its maxima there).
+#[cfg(feature = "solver")]
+fn grid_violations(norm: &NormalizedProblem, grid: &GridSolution) -> Vec<NormalizedLimit> {
+    let raw: Vec<Impulse> = grid
+        .times
+        .iter()
+        .zip(&grid.amplitudes)
+        .map(|(&time, &amplitude)| Impulse { time, amplitude })
+        .collect();
+    scan::check(norm, &raw).violations
+}
+
+/// While the polish fails (impulses too close for the grid to resolve, a poor start), the
+/// grid refined around the impulses the solution uses, solved and polished again, at most
+/// [`MAX_REFINEMENTS`] times. Returns the last grid and its polish.
+#[cfg(feature = "solver")]
+fn refine(
+    norm: &NormalizedProblem,
+    samples: &[NormalizedLimit],
+    mut grid: GridSolution,
+    mut polished: Option<Vec<Impulse>>,
+    programs: &mut usize,
+) -> Result<(GridSolution, Option<Vec<Impulse>>)> {
+    for _ in 0..MAX_REFINEMENTS {
+        if polished.is_some() {
+            break;
+        }
+        let pattern = refine_pattern(&grid);
+        grid = shortest_on_grid(norm, samples, Some((&pattern, grid.duration)), programs)?;
+        polished = polish::polish(norm, &grid);
+    }
+    Ok((grid, polished))
+}
+
+/// The impulses of the round: the polish if within the amplitude bounds, else the fallback
+/// (whether polished is returned too), rescaled to Σ A = 1, and refused (with the reason) if
+/// the rescaled amplitudes leave the bounds.
+#[cfg(feature = "solver")]
+fn accepted(
+    norm: &NormalizedProblem,
+    samples: &[NormalizedLimit],
+    grid: &GridSolution,
+    polished: Option<Vec<Impulse>>,
+    programs: &mut usize,
+) -> Result<(Vec<Impulse>, bool)> {
+    // The polish and the fallback's projection solve equalities and may step outside the
+    // amplitude bounds (the convergence grid found direct ZVDD designs with amplitudes down
+    // to −0.008 at amplitudeMin = 0): a result outside them is not accepted.
+    let (mut impulses, polished) = match polished.filter(|p| within_bounds(norm, p)) {
+        Some(imps) => (imps, true),
+        None => (fallback(norm, samples, grid, programs)?, false),
+    };
+    // Σ A = 1 only to the polish's Newton tolerance (the convergence grid found SI for four
+    // modes at 1 + 1.8e-8): rescale to Σ A = 1 to rounding. Everything after (the bounds,
+    // V ≤ Vtol, the zero moments) is checked on the rescaled amplitudes.
+    renormalize(&mut impulses);
+    if !within_bounds(norm, &impulses) {
+        let worst = impulses
+            .iter()
+            .map(|i| i.amplitude)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), a| {
+                (lo.min(a), hi.max(a))
+            });
+        return Err(Error::Infeasible {
+            reason: format!(
+                "the design's amplitudes ({:.6} … {:.6}) leave the bounds [{}, {}] when its \
+                 constraints are solved exactly: the problem is numerically degenerate here \
+                 (modes very close, many derivatives); widen the bounds or drop a derivative",
+                worst.0, worst.1, norm.amplitude_min, norm.amplitude_max
+            ),
+        });
+    }
+    Ok((impulses, polished))
 }
 
 /// The grid solution of the shortest feasible duration.
@@ -627,17 +680,45 @@ fn shortest_on_grid(
     refined: Option<(&[f64], f64)>,
     programs: &mut usize,
 ) -> Result<GridSolution> {
-    let solved = std::cell::Cell::new(0usize);
-    // Times for a duration: the uniform grid, or a refined pattern (relative times) scaled.
-    let times_for = |t: f64| -> Vec<f64> {
-        match refined {
+    let mut grid = GridPrograms {
+        norm,
+        samples,
+        refined,
+        programs,
+        solved: 0,
+    };
+    let (lo, hi) = bracket(&mut grid)?;
+    let hi = shrink(&mut grid, lo, hi)?;
+    hi.solution.ok_or_else(|| Error::Infeasible {
+        reason: infeasible_reason(norm),
+    })
+}
+
+/// The grid programs of one [`shortest_on_grid`] search, counted.
+struct GridPrograms<'a> {
+    norm: &'a NormalizedProblem,
+    samples: &'a [NormalizedLimit],
+    /// A refined pattern (relative times) and the coarse answer, or `None` for the uniform
+    /// grid.
+    refined: Option<(&'a [f64], f64)>,
+    /// Every program solved (over all searches).
+    programs: &'a mut usize,
+    /// Programs solved in this search.
+    solved: usize,
+}
+
+impl GridPrograms<'_> {
+    /// Times for a duration: the uniform grid, or the refined pattern scaled.
+    fn times_for(&self, t: f64) -> Vec<f64> {
+        match self.refined {
             None => grid_times(t),
             Some((pattern, _)) => pattern.iter().map(|s| s * t).collect(),
         }
-    };
-    // The finest spacing of the grid at duration t: the bracket is shrunk to half of it.
-    let resolution = |t: f64| -> f64 {
-        match refined {
+    }
+
+    /// The finest spacing of the grid at duration t: the bracket is shrunk to half of it.
+    fn resolution(&self, t: f64) -> f64 {
+        match self.refined {
             None => t / grid_intervals(t) as f64,
             Some((pattern, _)) => {
                 t * pattern
@@ -646,17 +727,28 @@ fn shortest_on_grid(
                     .fold(f64::INFINITY, f64::min)
             }
         }
-    };
-    let tight_level = if refined.is_some() { -1e-5 } else { -1e-2 };
-    let mut probe = |t: f64| -> Result<Probe> {
-        solved.set(solved.get() + 1);
-        *programs += 1;
-        let times = times_for(t);
-        let outcome = grid::solve_on_times(norm, samples, &times, None, grid::SEARCH_TOLERANCE)?;
+    }
+
+    /// The program at duration `t`.
+    fn probe(&mut self, t: f64) -> Result<Probe> {
+        self.solved += 1;
+        *self.programs += 1;
+        let times = self.times_for(t);
+        let outcome = grid::solve_on_times(
+            self.norm,
+            self.samples,
+            &times,
+            None,
+            grid::SEARCH_TOLERANCE,
+        )?;
         Ok(match outcome {
             Some(o) => Probe {
                 t,
-                level: if samples.is_empty() { 0.0 } else { o.level },
+                level: if self.samples.is_empty() {
+                    0.0
+                } else {
+                    o.level
+                },
                 solution: Some(GridSolution {
                     times,
                     amplitudes: o.amplitudes,
@@ -669,71 +761,82 @@ fn shortest_on_grid(
                 solution: None,
             },
         })
-    };
-    let ok = |p: &Probe| p.level <= 1.0 - FEASIBILITY_MARGIN && p.solution.is_some();
-    let limit = norm.max_duration;
+    }
+}
 
-    // Bracket [lo, hi]: lo infeasible (or 0), hi feasible. A refined grid starts from the
-    // coarse answer, which it can reproduce, and steps down from it.
-    let start = match refined {
+/// A probe meets the constraints (with a margin).
+fn feasible(p: &Probe) -> bool {
+    p.level <= 1.0 - FEASIBILITY_MARGIN && p.solution.is_some()
+}
+
+/// The bracket [lo, hi]: lo infeasible (or 0), hi feasible. From half a period of the lowest
+/// constrained frequency (a refined grid: from the coarse answer, which it can reproduce),
+/// stepping down while feasible, or up (×1.5, or past the secant's crossing) until feasible;
+/// an error past the duration limit.
+fn bracket(grid: &mut GridPrograms<'_>) -> Result<(Probe, Probe)> {
+    let norm = grid.norm;
+    let limit = norm.max_duration;
+    let start = match grid.refined {
         Some((_, known)) => known,
         None => (PI / norm.omega_min).min(limit),
     };
-    let first = probe(start)?;
-    let down = if refined.is_some() { 1.02 } else { 1.5 };
-    let (mut lo, mut hi) = if ok(&first) {
+    let first = grid.probe(start)?;
+    let down = if grid.refined.is_some() { 1.02 } else { 1.5 };
+    if feasible(&first) {
         let mut hi = first;
         loop {
             let t = hi.t / down;
             if t < 1e-3 {
-                break (
-                    Probe {
-                        t: 0.0,
-                        level: f64::INFINITY,
-                        solution: None,
-                    },
-                    hi,
-                );
+                let zero = Probe {
+                    t: 0.0,
+                    level: f64::INFINITY,
+                    solution: None,
+                };
+                return Ok((zero, hi));
             }
-            let p = probe(t)?;
-            if ok(&p) {
+            let p = grid.probe(t)?;
+            if feasible(&p) {
                 hi = p;
             } else {
-                break (p, hi);
+                return Ok((p, hi));
             }
         }
-    } else {
-        let mut lo = first;
-        let mut previous: Option<(f64, f64)> = None;
-        loop {
-            if lo.t >= limit {
-                return Err(Error::Infeasible {
-                    reason: infeasible_reason(norm),
-                });
-            }
-            // Step ×1.5, or to just past where the secant through the last two levels
-            // crosses 1 (kept within ×1.1 … ×2).
-            let f = lo.level.ln();
-            let step = match previous {
-                Some((t0, f0)) if f.is_finite() && f0.is_finite() && f0 > f && f > 0.0 => {
-                    let root = lo.t + (lo.t - t0) * f / (f0 - f);
-                    (1.02 * root).clamp(1.1 * lo.t, 2.0 * lo.t)
-                }
-                _ => 1.5 * lo.t,
-            };
-            let p = probe(step.min(limit))?;
-            if ok(&p) {
-                break (lo, p);
-            }
-            previous = Some((lo.t, f));
-            lo = p;
+    }
+    let mut lo = first;
+    let mut previous: Option<(f64, f64)> = None;
+    loop {
+        if lo.t >= limit {
+            return Err(Error::Infeasible {
+                reason: infeasible_reason(norm),
+            });
         }
-    };
+        // Step ×1.5, or to just past where the secant through the last two levels
+        // crosses 1 (kept within ×1.1 … ×2).
+        let f = lo.level.ln();
+        let step = match previous {
+            Some((t0, f0)) if f.is_finite() && f0.is_finite() && f0 > f && f > 0.0 => {
+                let root = lo.t + (lo.t - t0) * f / (f0 - f);
+                (1.02 * root).clamp(1.1 * lo.t, 2.0 * lo.t)
+            }
+            _ => 1.5 * lo.t,
+        };
+        let p = grid.probe(step.min(limit))?;
+        if feasible(&p) {
+            return Ok((lo, p));
+        }
+        previous = Some((lo.t, f));
+        lo = p;
+    }
+}
 
-    // Shrink the bracket.
+/// Shrinks the bracket by regula falsi on ln s(T) (Illinois), kept in the bracket's middle
+/// 90 %, until it is below half a grid step, a feasible level is within a fraction of the
+/// bound, or [`MAX_PROGRAMS`] programs were solved; returns the feasible end.
+fn shrink(grid: &mut GridPrograms<'_>, mut lo: Probe, mut hi: Probe) -> Result<Probe> {
+    let tight_level = if grid.refined.is_some() { -1e-5 } else { -1e-2 };
     let mut side = 0i32; // Illinois: which end was kept last time
     let (mut f_lo, mut f_hi) = (lo.level.ln(), hi.level.ln());
-    while hi.t - lo.t > resolution(hi.t) && solved.get() < MAX_PROGRAMS {
+    while hi.t - lo.t > grid.resolution(hi.t) && grid.solved < MAX_PROGRAMS {
         let mid = 0.5 * (lo.t + hi.t);
         let t = if f_lo.is_finite() && f_hi.is_finite() && f_lo > f_hi {
             // Root of the line through (lo, f_lo), (hi, f_hi), kept inside the middle 90 %.
@@ -742,9 +845,9 @@ fn shortest_on_grid(
         } else {
             mid
         };
-        let p = probe(t)?;
+        let p = grid.probe(t)?;
         let f = p.level.ln();
-        if ok(&p) {
+        if feasible(&p) {
             // Already within a fraction of the level of the bound: close enough.
             let tight = f > tight_level;
             hi = p;
@@ -765,9 +868,7 @@ fn shortest_on_grid(
             side = -1;
         }
     }
-    hi.solution.ok_or_else(|| Error::Infeasible {
-        reason: infeasible_reason(norm),
-    })
+    Ok(hi)
 }
 
 fn infeasible_reason(norm: &NormalizedProblem) -> String {

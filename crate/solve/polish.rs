@@ -328,6 +328,14 @@ impl Linearization {
         })
     }
 
+    /// `y` as the solution, with these multipliers.
+    fn solved(&self, y: Vec<f64>) -> Solved {
+        Solved {
+            y,
+            lambda: self.lambda.iter().copied().collect(),
+        }
+    }
+
     /// The least-norm δ with J δ = −c.
     fn restore(&self, c: &DVector<f64>) -> DVector<f64> {
         let mut dy = DVector::zeros(self.n);
@@ -348,14 +356,12 @@ impl Linearization {
 /// curved constraint sets.
 fn sqp(setup: &Setup, y0: Vec<f64>) -> Option<Solved> {
     let n = setup.n;
-    let di = setup.duration_index();
     let mut grad_f = DVector::zeros(n);
-    grad_f[di] = 1.0;
+    grad_f[setup.duration_index()] = 1.0;
     let mut y = y0;
     if !setup.valid(&y) {
         return None;
     }
-    let infeasibility = |c: &[f64]| c.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
     let (mut best_c, mut since_best) = (f64::INFINITY, 0);
     for _ in 0..MAX_NEWTON_ITERATIONS {
         let c = DVector::from_vec(setup.residuals(&y));
@@ -363,160 +369,185 @@ fn sqp(setup: &Setup, y0: Vec<f64>) -> Option<Solved> {
         let gz: Vec<f64> = lin.null.iter().map(|z| z.dot(&grad_f)).collect();
         let c_max = c.amax();
         let gz_max = gz.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        // Stalled far from c = 0: an inconsistent system, Gauss–Newton stuck in least squares.
         if c_max < 0.5 * best_c {
             (best_c, since_best) = (c_max, 0);
         } else if c_max > RESTORATION_THRESHOLD {
             since_best += 1;
             if since_best >= STALL_ITERATIONS {
-                return None; // an inconsistent system: Gauss–Newton is stuck in least squares
-            }
-        }
-        if c_max <= RESIDUAL_TOLERANCE && gz_max <= GRADIENT_TOLERANCE {
-            return Some(Solved {
-                y,
-                lambda: lin.lambda.iter().copied().collect(),
-            });
-        }
-        let dy_range = lin.restore(&c);
-        let step_to = |dy: &DVector<f64>, alpha: f64| -> Vec<f64> {
-            y.iter()
-                .zip(dy.iter())
-                .map(|(a, b)| a + alpha * b)
-                .collect()
-        };
-
-        if c_max > RESTORATION_THRESHOLD || lin.null.is_empty() {
-            // Gauss–Newton on c, line search on ‖c‖.
-            let mut accepted = None;
-            let mut alpha = 1.0;
-            for _ in 0..30 {
-                let trial = step_to(&dy_range, alpha);
-                if setup.valid(&trial) && infeasibility(&setup.residuals(&trial)) < c_max {
-                    accepted = Some(trial);
-                    break;
-                }
-                alpha *= 0.5;
-            }
-            match accepted {
-                Some(t) => y = t,
-                None if c_max <= 1e3 * RESIDUAL_TOLERANCE && gz_max <= GRADIENT_TOLERANCE => {
-                    return Some(Solved {
-                        y,
-                        lambda: lin.lambda.iter().copied().collect(),
-                    })
-                }
-                None => return None,
-            }
-            continue;
-        }
-
-        // Reduced Hessian of the Lagrangian L = t_n − λ·c along the null space (t_n is linear).
-        let lag = |yy: &[f64]| -> f64 {
-            let r = setup.residuals(yy);
-            -r.iter()
-                .zip(lin.lambda.iter())
-                .map(|(a, b)| a * b)
-                .sum::<f64>()
-        };
-        let nz = lin.null.len();
-        let mut hz = DMatrix::zeros(nz, nz);
-        let h = HESSIAN_STEP;
-        let shifted = |a: &DVector<f64>, b: &DVector<f64>, sa: f64, sb: f64| -> Vec<f64> {
-            y.iter()
-                .enumerate()
-                .map(|(i, &v)| v + h * (sa * a[i] + sb * b[i]))
-                .collect()
-        };
-        for p in 0..nz {
-            for q in p..nz {
-                let (a, b) = (&lin.null[p], &lin.null[q]);
-                let val = (lag(&shifted(a, b, 1.0, 1.0))
-                    - lag(&shifted(a, b, 1.0, -1.0))
-                    - lag(&shifted(a, b, -1.0, 1.0))
-                    + lag(&shifted(a, b, -1.0, -1.0)))
-                    / (4.0 * h * h);
-                hz[(p, q)] = val;
-                hz[(q, p)] = val;
-            }
-        }
-        // Positive definite (a minimum, not a saddle): eigenvalues by magnitude, floored.
-        let eig = hz.symmetric_eigen();
-        let emax = eig
-            .eigenvalues
-            .iter()
-            .fold(0.0_f64, |a, &b| a.max(b.abs()))
-            .max(1e-6);
-        let mut pz = DVector::zeros(nz);
-        for k in 0..nz {
-            let e = eig.eigenvalues[k].abs().max(1e-6 * emax);
-            let vk = eig.eigenvectors.column(k);
-            let g: f64 = vk.iter().zip(&gz).map(|(a, b)| a * b).sum();
-            pz -= vk * (g / e);
-        }
-        let mut null_step = DVector::zeros(n);
-        for (k, z) in lin.null.iter().enumerate() {
-            null_step += z * pz[k];
-        }
-        let big = null_step.amax();
-        if big > MAX_NULL_STEP {
-            null_step *= MAX_NULL_STEP / big;
-        }
-
-        // A trial point: the Gauss–Newton step plus α times the null-space step, pulled back
-        // onto c = 0 with the current Jacobian (chord iterations).
-        let trial_at = |alpha: f64| -> Option<Vec<f64>> {
-            let dy = &dy_range + &null_step * alpha;
-            let mut trial = step_to(&dy, 1.0);
-            for _ in 0..4 {
-                if !setup.valid(&trial) {
-                    return None;
-                }
-                let ct = DVector::from_vec(setup.residuals(&trial));
-                if ct.amax() <= RESIDUAL_TOLERANCE {
-                    break;
-                }
-                let corr = lin.restore(&ct);
-                for (t, d) in trial.iter_mut().zip(corr.iter()) {
-                    *t += d;
-                }
-            }
-            let ok = setup.valid(&trial)
-                && infeasibility(&setup.residuals(&trial)) <= c_max.max(RESIDUAL_TOLERANCE);
-            ok.then_some(trial)
-        };
-        // The restored point without the null-space step is the baseline the step must beat:
-        // making c = 0 exact may itself cost some duration.
-        let base = trial_at(0.0);
-        let mut accepted = None;
-        let mut alpha = 1.0;
-        for _ in 0..30 {
-            if let Some(trial) = trial_at(alpha) {
-                let beats = match &base {
-                    Some(b) => trial[di] < b[di],
-                    None => trial[di] < y[di],
-                };
-                if beats {
-                    accepted = Some(trial);
-                    break;
-                }
-            }
-            alpha *= 0.5;
-        }
-        match accepted.or(base.filter(|_| c_max > RESIDUAL_TOLERANCE)) {
-            Some(t) => y = t,
-            None => {
-                // No decrease found: converged as far as rounding allows, or stuck.
-                if c_max <= 1e3 * RESIDUAL_TOLERANCE && gz_max <= 1e3 * GRADIENT_TOLERANCE {
-                    return Some(Solved {
-                        y,
-                        lambda: lin.lambda.iter().copied().collect(),
-                    });
-                }
                 return None;
             }
         }
+        if c_max <= RESIDUAL_TOLERANCE && gz_max <= GRADIENT_TOLERANCE {
+            return Some(lin.solved(y));
+        }
+        let dy_range = lin.restore(&c);
+        // The step, and how far from optimal a point without one may still be accepted.
+        let (next, gradient_slack) = if c_max > RESTORATION_THRESHOLD || lin.null.is_empty() {
+            (restoration_step(setup, &y, &dy_range, c_max), 1.0)
+        } else {
+            let null_step = null_space_step(setup, &y, &lin, &gz);
+            (
+                optimality_step(setup, &y, &lin, &dy_range, &null_step, c_max),
+                1e3,
+            )
+        };
+        match next {
+            Some(t) => y = t,
+            // No decrease found: converged as far as rounding allows, or stuck.
+            None if c_max <= 1e3 * RESIDUAL_TOLERANCE
+                && gz_max <= gradient_slack * GRADIENT_TOLERANCE =>
+            {
+                return Some(lin.solved(y))
+            }
+            None => return None,
+        }
     }
     None
+}
+
+/// The largest |cᵢ|.
+fn infeasibility(c: &[f64]) -> f64 {
+    c.iter().fold(0.0_f64, |a, b| a.max(b.abs()))
+}
+
+/// y + α·dy.
+fn step_to(y: &[f64], dy: &DVector<f64>, alpha: f64) -> Vec<f64> {
+    y.iter()
+        .zip(dy.iter())
+        .map(|(a, b)| a + alpha * b)
+        .collect()
+}
+
+/// Far from c = 0: the Gauss–Newton step `dy_range` on c alone, halved until ‖c‖∞ falls below
+/// `c_max` (`None` if it never does).
+fn restoration_step(
+    setup: &Setup,
+    y: &[f64],
+    dy_range: &DVector<f64>,
+    c_max: f64,
+) -> Option<Vec<f64>> {
+    let mut alpha = 1.0;
+    for _ in 0..30 {
+        let trial = step_to(y, dy_range, alpha);
+        if setup.valid(&trial) && infeasibility(&setup.residuals(&trial)) < c_max {
+            return Some(trial);
+        }
+        alpha *= 0.5;
+    }
+    None
+}
+
+/// The Newton step on t_n in the null space of J at `y`: the reduced Hessian of the
+/// Lagrangian L = t_n − λ·c by central differences, its eigenvalues floored by magnitude (a
+/// minimum, not a saddle), the step capped at [`MAX_NULL_STEP`].
+fn null_space_step(setup: &Setup, y: &[f64], lin: &Linearization, gz: &[f64]) -> DVector<f64> {
+    // t_n is linear: only −λ·c is curved.
+    let lag = |yy: &[f64]| -> f64 {
+        let r = setup.residuals(yy);
+        -r.iter()
+            .zip(lin.lambda.iter())
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+    };
+    let nz = lin.null.len();
+    let mut hz = DMatrix::zeros(nz, nz);
+    let h = HESSIAN_STEP;
+    let shifted = |a: &DVector<f64>, b: &DVector<f64>, sa: f64, sb: f64| -> Vec<f64> {
+        y.iter()
+            .enumerate()
+            .map(|(i, &v)| v + h * (sa * a[i] + sb * b[i]))
+            .collect()
+    };
+    for p in 0..nz {
+        for q in p..nz {
+            let (a, b) = (&lin.null[p], &lin.null[q]);
+            let val = (lag(&shifted(a, b, 1.0, 1.0))
+                - lag(&shifted(a, b, 1.0, -1.0))
+                - lag(&shifted(a, b, -1.0, 1.0))
+                + lag(&shifted(a, b, -1.0, -1.0)))
+                / (4.0 * h * h);
+            hz[(p, q)] = val;
+            hz[(q, p)] = val;
+        }
+    }
+    // Positive definite (a minimum, not a saddle): eigenvalues by magnitude, floored.
+    let eig = hz.symmetric_eigen();
+    let emax = eig
+        .eigenvalues
+        .iter()
+        .fold(0.0_f64, |a, &b| a.max(b.abs()))
+        .max(1e-6);
+    let mut pz = DVector::zeros(nz);
+    for k in 0..nz {
+        let e = eig.eigenvalues[k].abs().max(1e-6 * emax);
+        let vk = eig.eigenvectors.column(k);
+        let g: f64 = vk.iter().zip(gz).map(|(a, b)| a * b).sum();
+        pz -= vk * (g / e);
+    }
+    let mut null_step = DVector::zeros(setup.n);
+    for (k, z) in lin.null.iter().enumerate() {
+        null_step += z * pz[k];
+    }
+    let big = null_step.amax();
+    if big > MAX_NULL_STEP {
+        null_step *= MAX_NULL_STEP / big;
+    }
+    null_step
+}
+
+/// Near c = 0: the Gauss–Newton step plus α times `null_step`, pulled back onto c = 0, with α
+/// halved until t_n beats the restored point without the null-space step (or, if that cannot
+/// be restored, the current one). Without such an α, the restored point itself while c is
+/// not yet at its tolerance; `None` otherwise.
+fn optimality_step(
+    setup: &Setup,
+    y: &[f64],
+    lin: &Linearization,
+    dy_range: &DVector<f64>,
+    null_step: &DVector<f64>,
+    c_max: f64,
+) -> Option<Vec<f64>> {
+    let di = setup.duration_index();
+    // A trial point: the Gauss–Newton step plus α times the null-space step, pulled back
+    // onto c = 0 with the current Jacobian (chord iterations).
+    let trial_at = |alpha: f64| -> Option<Vec<f64>> {
+        let dy = dy_range + null_step * alpha;
+        let mut trial = step_to(y, &dy, 1.0);
+        for _ in 0..4 {
+            if !setup.valid(&trial) {
+                return None;
+            }
+            let ct = DVector::from_vec(setup.residuals(&trial));
+            if ct.amax() <= RESIDUAL_TOLERANCE {
+                break;
+            }
+            let corr = lin.restore(&ct);
+            for (t, d) in trial.iter_mut().zip(corr.iter()) {
+                *t += d;
+            }
+        }
+        let ok = setup.valid(&trial)
+            && infeasibility(&setup.residuals(&trial)) <= c_max.max(RESIDUAL_TOLERANCE);
+        ok.then_some(trial)
+    };
+    // The restored point without the null-space step is the baseline the step must beat:
+    // making c = 0 exact may itself cost some duration.
+    let base = trial_at(0.0);
+    let mut alpha = 1.0;
+    for _ in 0..30 {
+        if let Some(trial) = trial_at(alpha) {
+            let beats = match &base {
+                Some(b) => trial[di] < b[di],
+                None => trial[di] < y[di],
+            };
+            if beats {
+                return Some(trial);
+            }
+        }
+        alpha *= 0.5;
+    }
+    base.filter(|_| c_max > RESIDUAL_TOLERANCE)
 }
 
 /// The state of the active-set loop: impulses and active points.
