@@ -145,9 +145,28 @@ impl Pendulum {
         }
         let empty = Piecewise::new(Vec::new())?;
         let hoist = self.hoist.as_ref().unwrap_or(&empty);
-        // The cable must stay long enough over the whole window (checked before integrating,
-        // densely on every polynomial piece of the hoist).
         let t_end = samples.saturating_sub(1) as f64 * sample_period;
+        self.check_cable(hoist, t_end)?;
+        let mut swing = Swing::new(self, command, hoist, sample_period);
+        let mut out = PendulumResponse {
+            angle: Vec::with_capacity(samples),
+            endpoint: Vec::with_capacity(samples),
+            endpoint_velocity: Vec::with_capacity(samples),
+            endpoint_acceleration: Vec::with_capacity(samples),
+            length: Vec::with_capacity(samples),
+            steps: 0,
+        };
+        for k in 0..samples {
+            swing.advance_to(k as f64 * sample_period)?;
+            swing.record(&mut out);
+        }
+        out.steps = swing.steps;
+        Ok(out)
+    }
+
+    /// The cable must stay long enough over the whole window [0, `t_end`] (checked before
+    /// integrating, densely on every polynomial piece of the hoist).
+    fn check_cable(&self, hoist: &Piecewise, t_end: f64) -> Result<()> {
         let mut checks: Vec<f64> = (0..=256).map(|i| t_end * i as f64 / 256.0).collect();
         let hk = hoist.knots();
         for (i, k) in hk.iter().enumerate() {
@@ -168,111 +187,157 @@ impl Pendulum {
                 ));
             }
         }
-        let mut trolley = Cursor::new(command);
-        let mut cable = Cursor::new(hoist);
-        let w0 = (self.gravity / self.length).sqrt();
-        let c_damp = 2.0 * self.damping * w0;
-        let g = self.gravity;
-        let l0 = self.length;
-        let mut y = [self.initial_angle, 0.0];
-        let mut t = 0.0_f64;
-        let mut h = (0.01 / w0).min(sample_period.max(1e-9));
-        let mut steps = 0usize;
-        let mut out = PendulumResponse {
-            angle: Vec::with_capacity(samples),
-            endpoint: Vec::with_capacity(samples),
-            endpoint_velocity: Vec::with_capacity(samples),
-            endpoint_acceleration: Vec::with_capacity(samples),
-            length: Vec::with_capacity(samples),
+        Ok(())
+    }
+}
+
+/// The integration of a swing: the cursors on the trolley command and the hoist, the state
+/// y = (θ, θ') at time t, the adaptive step size and the steps taken.
+struct Swing<'a> {
+    command: &'a Piecewise,
+    hoist: &'a Piecewise,
+    trolley: Cursor<'a>,
+    cable: Cursor<'a>,
+    /// Gravity, m/s².
+    g: f64,
+    /// Cable length without the hoist, m.
+    l0: f64,
+    /// Damping coefficient 2ζω₀, 1/s.
+    c_damp: f64,
+    y: [f64; 2],
+    t: f64,
+    h: f64,
+    steps: usize,
+}
+
+impl<'a> Swing<'a> {
+    /// At rest at t = 0 at the pendulum's initial angle; the first step a hundredth of a
+    /// radian of the linear swing (at most a sample period).
+    fn new(
+        p: &Pendulum,
+        command: &'a Piecewise,
+        hoist: &'a Piecewise,
+        sample_period: f64,
+    ) -> Swing<'a> {
+        let w0 = (p.gravity / p.length).sqrt();
+        Swing {
+            command,
+            hoist,
+            trolley: Cursor::new(command),
+            cable: Cursor::new(hoist),
+            g: p.gravity,
+            l0: p.length,
+            c_damp: 2.0 * p.damping * w0,
+            y: [p.initial_angle, 0.0],
+            t: 0.0,
+            h: (0.01 / w0).min(sample_period.max(1e-9)),
             steps: 0,
-        };
-        let tk = command.knots();
-        for k in 0..samples {
-            let target = k as f64 * sample_period;
-            loop {
-                // Apply every knot at the current time.
-                while let Some(kn) = tk.get(trolley.next_index()).filter(|kn| kn.time <= t) {
-                    let l = l0 + cable.state_at(t)[0];
-                    y[1] -= kn.jumps[1] * y[0].cos() / l;
-                    trolley.pass_next();
-                }
-                while hk.get(cable.next_index()).is_some_and(|kn| kn.time <= t) {
-                    cable.pass_next();
-                }
-                if t >= target {
-                    break;
-                }
-                let next_knot = [
-                    tk.get(trolley.next_index())
-                        .map_or(f64::INFINITY, |k| k.time),
-                    hk.get(cable.next_index()).map_or(f64::INFINITY, |k| k.time),
-                ];
-                let stop = target.min(next_knot[0]).min(next_knot[1]);
-                let (ts, rs) = (t, trolley.state_at(t));
-                let (_, ls) = (t, cable.state_at(t));
-                let (rdeg, ldeg) = (command.degree(), hoist.degree());
-                let rhs = |tt: f64, s: &[f64; 2]| -> Result<[f64; 2]> {
-                    let r = crate::piecewise::taylor_shift(&rs, rdeg, tt - ts);
-                    let l = crate::piecewise::taylor_shift(&ls, ldeg, tt - ts);
-                    let len = l0 + l[0];
-                    if len.is_nan() || len <= 0.0 {
-                        return Err(Error::invalid(
-                            "hoist",
-                            format!(
-                                "the cable length reaches {len} m at t = {tt} s; it must stay > 0"
-                            ),
-                        ));
-                    }
-                    let acc = -(g * s[0].sin() + r[2] * s[0].cos() + 2.0 * l[1] * s[1]) / len
-                        - c_damp * s[1];
-                    Ok([s[1], acc])
-                };
-                while t < stop {
-                    steps += 1;
-                    if steps > MAX_STEPS {
-                        return Err(Error::TooLarge {
-                            field: "duration".into(),
-                            value: steps as f64,
-                            limit: MAX_STEPS as f64,
-                        });
-                    }
-                    let hh = h.min(stop - t);
-                    let (ynew, err) = dopri_step(&rhs, t, &y, hh)?;
-                    let sc = |i: usize| ATOL + RTOL * y[i].abs().max(ynew[i].abs());
-                    let e = (err[0] / sc(0)).abs().max((err[1] / sc(1)).abs());
-                    if e <= 1.0 || hh < 1e-12 {
-                        t = if hh == stop - t { stop } else { t + hh };
-                        y = ynew;
-                    }
-                    let factor = if e == 0.0 {
-                        5.0
-                    } else {
-                        (0.9 * e.powf(-0.2)).clamp(0.2, 5.0)
-                    };
-                    h = (hh * factor).max(1e-12);
-                    if !y[0].is_finite() || !y[1].is_finite() {
-                        return Err(Error::invalid(
-                            "plant",
-                            "the pendulum's swing diverged (check the command and the hoist)",
-                        ));
-                    }
-                }
-            }
-            let r = trolley.state_at(t);
-            let l = cable.state_at(t);
-            let len = l0 + l[0];
-            let (s, c) = y[0].sin_cos();
-            let th_dd = -(g * s + r[2] * c + 2.0 * l[1] * y[1]) / len - c_damp * y[1];
-            out.angle.push(y[0]);
-            out.length.push(len);
-            out.endpoint.push(r[0] + len * s);
-            out.endpoint_velocity.push(r[1] + l[1] * s + len * c * y[1]);
-            out.endpoint_acceleration.push(
-                r[2] + l[2] * s + 2.0 * l[1] * c * y[1] + len * (c * th_dd - s * y[1] * y[1]),
-            );
         }
-        out.steps = steps;
-        Ok(out)
+    }
+
+    /// Integrates up to `target`, stopping at every knot of the command and the hoist.
+    fn advance_to(&mut self, target: f64) -> Result<()> {
+        let (command, hoist): (&'a Piecewise, &'a Piecewise) = (self.command, self.hoist);
+        let (tk, hk) = (command.knots(), hoist.knots());
+        loop {
+            // Apply every knot at the current time: a jump in the trolley's velocity kicks
+            // the swing's rate.
+            while let Some(kn) = tk
+                .get(self.trolley.next_index())
+                .filter(|kn| kn.time <= self.t)
+            {
+                let l = self.l0 + self.cable.state_at(self.t)[0];
+                self.y[1] -= kn.jumps[1] * self.y[0].cos() / l;
+                self.trolley.pass_next();
+            }
+            while hk
+                .get(self.cable.next_index())
+                .is_some_and(|kn| kn.time <= self.t)
+            {
+                self.cable.pass_next();
+            }
+            if self.t >= target {
+                return Ok(());
+            }
+            let next_knot = [
+                tk.get(self.trolley.next_index())
+                    .map_or(f64::INFINITY, |k| k.time),
+                hk.get(self.cable.next_index())
+                    .map_or(f64::INFINITY, |k| k.time),
+            ];
+            self.integrate_to(target.min(next_knot[0]).min(next_knot[1]))?;
+        }
+    }
+
+    /// Dormand–Prince steps with error control up to `stop`, with no knot before it.
+    fn integrate_to(&mut self, stop: f64) -> Result<()> {
+        let (g, l0, c_damp) = (self.g, self.l0, self.c_damp);
+        let (ts, rs) = (self.t, self.trolley.state_at(self.t));
+        let ls = self.cable.state_at(self.t);
+        let (rdeg, ldeg) = (self.command.degree(), self.hoist.degree());
+        let rhs = |tt: f64, s: &[f64; 2]| -> Result<[f64; 2]> {
+            let r = crate::piecewise::taylor_shift(&rs, rdeg, tt - ts);
+            let l = crate::piecewise::taylor_shift(&ls, ldeg, tt - ts);
+            let len = l0 + l[0];
+            if len.is_nan() || len <= 0.0 {
+                return Err(Error::invalid(
+                    "hoist",
+                    format!("the cable length reaches {len} m at t = {tt} s; it must stay > 0"),
+                ));
+            }
+            let acc =
+                -(g * s[0].sin() + r[2] * s[0].cos() + 2.0 * l[1] * s[1]) / len - c_damp * s[1];
+            Ok([s[1], acc])
+        };
+        while self.t < stop {
+            self.steps += 1;
+            if self.steps > MAX_STEPS {
+                return Err(Error::TooLarge {
+                    field: "duration".into(),
+                    value: self.steps as f64,
+                    limit: MAX_STEPS as f64,
+                });
+            }
+            let (t, y) = (self.t, self.y);
+            let hh = self.h.min(stop - t);
+            let (ynew, err) = dopri_step(&rhs, t, &y, hh)?;
+            let sc = |i: usize| ATOL + RTOL * y[i].abs().max(ynew[i].abs());
+            let e = (err[0] / sc(0)).abs().max((err[1] / sc(1)).abs());
+            if e <= 1.0 || hh < 1e-12 {
+                self.t = if hh == stop - t { stop } else { t + hh };
+                self.y = ynew;
+            }
+            let factor = if e == 0.0 {
+                5.0
+            } else {
+                (0.9 * e.powf(-0.2)).clamp(0.2, 5.0)
+            };
+            self.h = (hh * factor).max(1e-12);
+            if !self.y[0].is_finite() || !self.y[1].is_finite() {
+                return Err(Error::invalid(
+                    "plant",
+                    "the pendulum's swing diverged (check the command and the hoist)",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Appends the sample at the current time: angle, cable length and the payload's
+    /// horizontal position, velocity and acceleration.
+    fn record(&self, out: &mut PendulumResponse) {
+        let (g, c_damp, y) = (self.g, self.c_damp, self.y);
+        let r = self.trolley.state_at(self.t);
+        let l = self.cable.state_at(self.t);
+        let len = self.l0 + l[0];
+        let (s, c) = y[0].sin_cos();
+        let th_dd = -(g * s + r[2] * c + 2.0 * l[1] * y[1]) / len - c_damp * y[1];
+        out.angle.push(y[0]);
+        out.length.push(len);
+        out.endpoint.push(r[0] + len * s);
+        out.endpoint_velocity.push(r[1] + l[1] * s + len * c * y[1]);
+        out.endpoint_acceleration
+            .push(r[2] + l[2] * s + 2.0 * l[1] * c * y[1] + len * (c * th_dd - s * y[1] * y[1]));
     }
 }
 
