@@ -103,7 +103,7 @@ impl System {
             .collect()
     }
 
-    /// Residual F(x) and Jacobian J(x).
+    /// Residual F(x) and Jacobian J(x): each equation fills its rows (see [`Block`]).
     fn evaluate(&self, x: &DVector<f64>) -> (DVector<f64>, DMatrix<f64>) {
         let rows: usize = self.equations.iter().map(|(e, _)| e.rows()).sum();
         let mut f = DVector::zeros(rows);
@@ -111,128 +111,197 @@ impl System {
         let all = self.impulses(x);
         let mut row = 0;
         for (equation, range) in &self.equations {
-            let imps = &all[range.clone()];
-            let a_col = |k: usize| match self.amplitudes[range.start + k] {
-                Param::Free(c) => Some(c),
-                Param::Fixed(_) => None,
+            let block = Block {
+                imps: &all[range.clone()],
+                amplitudes: &self.amplitudes[range.clone()],
+                times: &self.times[range.clone()],
+                row,
             };
-            let t_col = |k: usize| match self.times[range.start + k] {
-                Param::Free(c) => Some(c),
-                Param::Fixed(_) => None,
-            };
+            let (f, j) = (&mut f, &mut j);
             match equation {
-                Equation::AmplitudeSum(value) => {
-                    f[row] = imps.iter().map(|i| i.amplitude).sum::<f64>() - value;
-                    for k in 0..imps.len() {
-                        if let Some(c) = a_col(k) {
-                            j[(row, c)] += 1.0;
-                        }
-                    }
-                }
-                Equation::Span(value) => {
-                    let last = imps.len() - 1;
-                    f[row] = imps[last].time - imps[0].time - value;
-                    if let Some(c) = t_col(last) {
-                        j[(row, c)] += 1.0;
-                    }
-                    if let Some(c) = t_col(0) {
-                        j[(row, c)] -= 1.0;
-                    }
-                }
+                Equation::AmplitudeSum(value) => block.amplitude_sum(*value, f, j),
+                Equation::Span(value) => block.span(*value, f, j),
                 Equation::Moment {
                     order,
                     value,
                     scale,
-                } => {
-                    let k_fact: f64 = (1..=*order).map(f64::from).product();
-                    let last = imps.len() - 1;
-                    let t_l = imps[last].time;
-                    let mut sum = 0.0;
-                    let mut d_last = 0.0;
-                    for (k, imp) in imps.iter().enumerate() {
-                        let d = t_l - imp.time;
-                        sum += imp.amplitude * d.powi(*order as i32) / k_fact;
-                        if let Some(c) = a_col(k) {
-                            j[(row, c)] += d.powi(*order as i32) / k_fact;
-                        }
-                        if k != last {
-                            // ∂/∂tₖ of Aₖ (t_L − tₖ)^m/m! = −Aₖ (t_L − tₖ)^{m−1}/(m−1)!
-                            let g = imp.amplitude * d.powi(*order as i32 - 1) * f64::from(*order)
-                                / k_fact;
-                            if let Some(c) = t_col(k) {
-                                j[(row, c)] -= g;
-                            }
-                            d_last += g;
-                        }
-                    }
-                    if let Some(c) = t_col(last) {
-                        j[(row, c)] += d_last;
-                    }
-                    f[row] = sum - value;
-                    f[row] /= scale;
-                    for c in 0..self.unknowns {
-                        j[(row, c)] /= scale;
-                    }
-                }
-                Equation::Zero(freq) | Equation::ZeroSlope(freq) => {
-                    let w = freq.value(x);
-                    let p = vibration_phasor(imps, w, self.zeta);
-                    let slope = matches!(equation, Equation::ZeroSlope(_));
-                    let (value, d_w, d_a, d_t) = if slope {
-                        (
-                            p.d_omega,
-                            p.d_omega2,
-                            &p.d_omega_d_amplitude,
-                            &p.d_omega_d_time,
-                        )
-                    } else {
-                        (p.value, p.d_omega, &p.d_amplitude, &p.d_time)
-                    };
-                    let mut put = |col: usize, d: Complex<f64>| {
-                        j[(row, col)] += d.re;
-                        j[(row + 1, col)] += d.im;
-                    };
-                    for k in 0..imps.len() {
-                        if let Some(c) = a_col(k) {
-                            put(c, d_a[k]);
-                        }
-                        if let Some(c) = t_col(k) {
-                            put(c, d_t[k]);
-                        }
-                    }
-                    if let Param::Free(c) = freq {
-                        put(*c, d_w);
-                    }
-                    f[row] = value.re;
-                    f[row + 1] = value.im;
-                }
+                } => block.moment(*order, *value, *scale, f, j),
+                Equation::Zero(freq) => block.zero(*freq, x, self.zeta, false, f, j),
+                Equation::ZeroSlope(freq) => block.zero(*freq, x, self.zeta, true, f, j),
                 Equation::Hump { frequency, vtol } => {
-                    let w = frequency.value(x);
-                    let p = vibration_phasor(imps, w, self.zeta);
-                    let (pv, pw) = (p.value, p.d_omega);
-                    // h₁ = (|P|² − v²)/(2v), h₂ = Re(P̄ P')/v  (h₂ = ½ d|P|²/dω / v).
-                    f[row] = (pv.norm_sqr() - vtol * vtol) / (2.0 * vtol);
-                    f[row + 1] = (pv.conj() * pw).re / vtol;
-                    let mut put = |col: usize, dp: Complex<f64>, dpw: Complex<f64>| {
-                        j[(row, col)] += (pv.conj() * dp).re / vtol;
-                        j[(row + 1, col)] += (dp.conj() * pw + pv.conj() * dpw).re / vtol;
-                    };
-                    for k in 0..imps.len() {
-                        if let Some(c) = a_col(k) {
-                            put(c, p.d_amplitude[k], p.d_omega_d_amplitude[k]);
-                        }
-                        if let Some(c) = t_col(k) {
-                            put(c, p.d_time[k], p.d_omega_d_time[k]);
-                        }
-                    }
-                    if let Param::Free(c) = frequency {
-                        put(*c, pw, p.d_omega2);
-                    }
+                    block.hump(*frequency, *vtol, x, self.zeta, f, j)
                 }
             }
             row += equation.rows();
         }
         (f, j)
+    }
+}
+
+/// The rows of one equation: its impulses, their amplitudes' and times' parameters, and its
+/// first row in F and J.
+struct Block<'s> {
+    imps: &'s [Impulse],
+    amplitudes: &'s [Param],
+    times: &'s [Param],
+    row: usize,
+}
+
+impl Block<'_> {
+    /// The column of impulse `k`'s amplitude, if it is an unknown.
+    fn a_col(&self, k: usize) -> Option<usize> {
+        match self.amplitudes[k] {
+            Param::Free(c) => Some(c),
+            Param::Fixed(_) => None,
+        }
+    }
+
+    /// The column of impulse `k`'s time, if it is an unknown.
+    fn t_col(&self, k: usize) -> Option<usize> {
+        match self.times[k] {
+            Param::Free(c) => Some(c),
+            Param::Fixed(_) => None,
+        }
+    }
+
+    /// Σ Aᵢ = `value`.
+    fn amplitude_sum(&self, value: f64, f: &mut DVector<f64>, j: &mut DMatrix<f64>) {
+        let (imps, row) = (self.imps, self.row);
+        f[row] = imps.iter().map(|i| i.amplitude).sum::<f64>() - value;
+        for k in 0..imps.len() {
+            if let Some(c) = self.a_col(k) {
+                j[(row, c)] += 1.0;
+            }
+        }
+    }
+
+    /// t_L − t_F = `value`.
+    fn span(&self, value: f64, f: &mut DVector<f64>, j: &mut DMatrix<f64>) {
+        let (imps, row) = (self.imps, self.row);
+        let last = imps.len() - 1;
+        f[row] = imps[last].time - imps[0].time - value;
+        if let Some(c) = self.t_col(last) {
+            j[(row, c)] += 1.0;
+        }
+        if let Some(c) = self.t_col(0) {
+            j[(row, c)] -= 1.0;
+        }
+    }
+
+    /// Σ Aᵢ (t_L − tᵢ)^order / order! = `value`, the row divided by `scale`.
+    fn moment(
+        &self,
+        order: u32,
+        value: f64,
+        scale: f64,
+        f: &mut DVector<f64>,
+        j: &mut DMatrix<f64>,
+    ) {
+        let (imps, row) = (self.imps, self.row);
+        let k_fact: f64 = (1..=order).map(f64::from).product();
+        let last = imps.len() - 1;
+        let t_l = imps[last].time;
+        let mut sum = 0.0;
+        let mut d_last = 0.0;
+        for (k, imp) in imps.iter().enumerate() {
+            let d = t_l - imp.time;
+            sum += imp.amplitude * d.powi(order as i32) / k_fact;
+            if let Some(c) = self.a_col(k) {
+                j[(row, c)] += d.powi(order as i32) / k_fact;
+            }
+            if k != last {
+                // ∂/∂tₖ of Aₖ (t_L − tₖ)^m/m! = −Aₖ (t_L − tₖ)^{m−1}/(m−1)!
+                let g = imp.amplitude * d.powi(order as i32 - 1) * f64::from(order) / k_fact;
+                if let Some(c) = self.t_col(k) {
+                    j[(row, c)] -= g;
+                }
+                d_last += g;
+            }
+        }
+        if let Some(c) = self.t_col(last) {
+            j[(row, c)] += d_last;
+        }
+        f[row] = sum - value;
+        f[row] /= scale;
+        for c in 0..j.ncols() {
+            j[(row, c)] /= scale;
+        }
+    }
+
+    /// P(ω) = 0 at ω = `freq` (or, with `slope`, ∂P/∂ω = 0): real and imaginary parts.
+    fn zero(
+        &self,
+        freq: Param,
+        x: &DVector<f64>,
+        zeta: f64,
+        slope: bool,
+        f: &mut DVector<f64>,
+        j: &mut DMatrix<f64>,
+    ) {
+        let (imps, row) = (self.imps, self.row);
+        let w = freq.value(x);
+        let p = vibration_phasor(imps, w, zeta);
+        let (value, d_w, d_a, d_t) = if slope {
+            (
+                p.d_omega,
+                p.d_omega2,
+                &p.d_omega_d_amplitude,
+                &p.d_omega_d_time,
+            )
+        } else {
+            (p.value, p.d_omega, &p.d_amplitude, &p.d_time)
+        };
+        let mut put = |col: usize, d: Complex<f64>| {
+            j[(row, col)] += d.re;
+            j[(row + 1, col)] += d.im;
+        };
+        for k in 0..imps.len() {
+            if let Some(c) = self.a_col(k) {
+                put(c, d_a[k]);
+            }
+            if let Some(c) = self.t_col(k) {
+                put(c, d_t[k]);
+            }
+        }
+        if let Param::Free(c) = freq {
+            put(c, d_w);
+        }
+        f[row] = value.re;
+        f[row + 1] = value.im;
+    }
+
+    /// A hump at ω = `frequency`: V = `vtol` and dV/dω = 0, both rows scaled by 1/vtol.
+    fn hump(
+        &self,
+        frequency: Param,
+        vtol: f64,
+        x: &DVector<f64>,
+        zeta: f64,
+        f: &mut DVector<f64>,
+        j: &mut DMatrix<f64>,
+    ) {
+        let (imps, row) = (self.imps, self.row);
+        let w = frequency.value(x);
+        let p = vibration_phasor(imps, w, zeta);
+        let (pv, pw) = (p.value, p.d_omega);
+        // h₁ = (|P|² − v²)/(2v), h₂ = Re(P̄ P')/v  (h₂ = ½ d|P|²/dω / v).
+        f[row] = (pv.norm_sqr() - vtol * vtol) / (2.0 * vtol);
+        f[row + 1] = (pv.conj() * pw).re / vtol;
+        let mut put = |col: usize, dp: Complex<f64>, dpw: Complex<f64>| {
+            j[(row, col)] += (pv.conj() * dp).re / vtol;
+            j[(row + 1, col)] += (dp.conj() * pw + pv.conj() * dpw).re / vtol;
+        };
+        for k in 0..imps.len() {
+            if let Some(c) = self.a_col(k) {
+                put(c, p.d_amplitude[k], p.d_omega_d_amplitude[k]);
+            }
+            if let Some(c) = self.t_col(k) {
+                put(c, p.d_time[k], p.d_omega_d_time[k]);
+            }
+        }
+        if let Param::Free(c) = frequency {
+            put(c, pw, p.d_omega2);
+        }
     }
 }
 

@@ -401,137 +401,134 @@ fn per_mode(modes: &[Mode], single: impl Fn(&Mode) -> Result<Shaper>) -> Result<
 /// breaks its promise.
 pub(crate) fn verify(shaper: &Shaper, modes: &[Mode], guarantee: &Guarantee) -> Result<()> {
     match guarantee {
-        Guarantee::Valid => {}
-        Guarantee::All(all) => {
-            for g in all {
-                verify(shaper, modes, g)?;
-            }
-        }
-        Guarantee::RestToRest { travel } => {
-            let imps = shaper.impulses();
-            let t_n = shaper.duration();
-            let total: f64 = imps.iter().map(|i| i.amplitude.abs()).sum();
-            let sum: f64 = imps.iter().map(|i| i.amplitude).sum();
-            let velocity: f64 = imps.iter().map(|i| i.amplitude * (t_n - i.time)).sum();
-            let position: f64 = imps
-                .iter()
-                .map(|i| 0.5 * i.amplitude * (t_n - i.time).powi(2))
-                .sum();
-            let ok = sum.abs() <= 1e-12 * total
-                && velocity.abs() <= 1e-9 * total * t_n
-                && (position - travel).abs() <= 1e-9 * travel;
-            if !ok {
-                return Err(Error::Infeasible {
-                    reason: format!(
-                        "the designed move does not end at rest at the requested distance \
-                         (Σ A = {sum:.3e}, final velocity {velocity:.3e}, travel {position} \
-                         instead of {travel})"
-                    ),
-                });
-            }
-        }
-        Guarantee::ZeroAt(points) => {
-            for &(f, z) in points {
-                let v = crate::vibration::vibration_rad(
-                    shaper.impulses(),
-                    2.0 * std::f64::consts::PI * f,
-                    z,
-                );
-                if v.is_nan() || v > ZERO_VIBRATION_TOLERANCE {
-                    return Err(Error::Infeasible {
-                        reason: format!(
-                            "the designed shaper leaves V = {v:.3e} at {f} Hz, ζ = {z}, where it \
-                             should vanish"
-                        ),
-                    });
-                }
-            }
-        }
+        Guarantee::Valid => Ok(()),
+        Guarantee::All(all) => all.iter().try_for_each(|g| verify(shaper, modes, g)),
+        Guarantee::RestToRest { travel } => verify_rest_to_rest(shaper, *travel),
+        Guarantee::ZeroAt(points) => points
+            .iter()
+            .try_for_each(|&(f, z)| verify_zero_at(shaper, f, z)),
         Guarantee::AtMost {
             vtol,
             points,
             tolerance,
-        } => {
-            for &(f, z) in points {
-                let v = crate::vibration::vibration_rad(
-                    shaper.impulses(),
-                    2.0 * std::f64::consts::PI * f,
-                    z,
-                );
-                if v.is_nan() || v > vtol + tolerance {
-                    return Err(Error::Infeasible {
-                        reason: format!(
-                            "the designed shaper leaves V = {:.4} % at {f} Hz, ζ = {z}, above \
-                             Vtol = {:.4} %",
-                            v * 100.0,
-                            vtol * 100.0
-                        ),
-                    });
-                }
-            }
-        }
+        } => points
+            .iter()
+            .try_for_each(|&(f, z)| verify_at_most(shaper, f, z, *vtol, vtol + tolerance)),
         Guarantee::WithinTolerance { points, tolerance } => {
-            for &(f, z, vtol) in points {
-                let v = crate::vibration::vibration_rad(
-                    shaper.impulses(),
-                    2.0 * std::f64::consts::PI * f,
-                    z,
-                );
-                if v.is_nan() || v > vtol * (1.0 + tolerance) {
-                    return Err(Error::Infeasible {
-                        reason: format!(
-                            "the designed shaper leaves V = {:.4} % at {f} Hz, ζ = {z}, above \
-                             Vtol = {:.4} %",
-                            v * 100.0,
-                            vtol * 100.0
-                        ),
-                    });
-                }
-            }
+            points.iter().try_for_each(|&(f, z, vtol)| {
+                verify_at_most(shaper, f, z, vtol, vtol * (1.0 + tolerance))
+            })
         }
         Guarantee::ZeroDerivativesAtModes { derivatives } => {
-            let t_n = shaper.duration().max(f64::MIN_POSITIVE);
-            for (i, mode) in modes.iter().enumerate() {
-                for k in 0..=*derivatives {
-                    let [c, s] = crate::vibration::vibration_moment(
-                        shaper.impulses(),
-                        mode.omega_rad_s(),
-                        mode.damping(),
-                        k,
-                    );
-                    let m = c.hypot(s) / t_n.powi(k as i32);
-                    if m.is_nan() || m > ZERO_VIBRATION_TOLERANCE {
-                        return Err(Error::Infeasible {
-                            reason: format!(
-                                "the designed shaper leaves a vibration moment of order {k} of \
-                                 {m:.3e} at modes[{i}] ({} Hz, ζ = {})",
-                                mode.frequency_hz(),
-                                mode.damping()
-                            ),
-                        });
-                    }
-                }
+            verify_zero_moments(shaper, modes, *derivatives)
+        }
+        Guarantee::ZeroAtModes => verify_zero_at_modes(shaper, modes),
+    }
+}
+
+/// V at (`f` Hz, ζ = `z`), from the impulses themselves.
+fn vibration_at(shaper: &Shaper, f: f64, z: f64) -> f64 {
+    crate::vibration::vibration_rad(shaper.impulses(), 2.0 * std::f64::consts::PI * f, z)
+}
+
+/// A move that ends at rest (Σ A = 0, final velocity 0) having travelled `travel`.
+fn verify_rest_to_rest(shaper: &Shaper, travel: f64) -> Result<()> {
+    let imps = shaper.impulses();
+    let t_n = shaper.duration();
+    let total: f64 = imps.iter().map(|i| i.amplitude.abs()).sum();
+    let sum: f64 = imps.iter().map(|i| i.amplitude).sum();
+    let velocity: f64 = imps.iter().map(|i| i.amplitude * (t_n - i.time)).sum();
+    let position: f64 = imps
+        .iter()
+        .map(|i| 0.5 * i.amplitude * (t_n - i.time).powi(2))
+        .sum();
+    let ok = sum.abs() <= 1e-12 * total
+        && velocity.abs() <= 1e-9 * total * t_n
+        && (position - travel).abs() <= 1e-9 * travel;
+    if !ok {
+        return Err(Error::Infeasible {
+            reason: format!(
+                "the designed move does not end at rest at the requested distance \
+                 (Σ A = {sum:.3e}, final velocity {velocity:.3e}, travel {position} \
+                 instead of {travel})"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// V vanishes (to [`ZERO_VIBRATION_TOLERANCE`]) at (`f` Hz, ζ = `z`).
+fn verify_zero_at(shaper: &Shaper, f: f64, z: f64) -> Result<()> {
+    let v = vibration_at(shaper, f, z);
+    if v.is_nan() || v > ZERO_VIBRATION_TOLERANCE {
+        return Err(Error::Infeasible {
+            reason: format!(
+                "the designed shaper leaves V = {v:.3e} at {f} Hz, ζ = {z}, where it should \
+                 vanish"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// V ≤ `limit` at (`f` Hz, ζ = `z`), the error naming the tolerable level `vtol`.
+fn verify_at_most(shaper: &Shaper, f: f64, z: f64, vtol: f64, limit: f64) -> Result<()> {
+    let v = vibration_at(shaper, f, z);
+    if v.is_nan() || v > limit {
+        return Err(Error::Infeasible {
+            reason: format!(
+                "the designed shaper leaves V = {:.4} % at {f} Hz, ζ = {z}, above Vtol = {:.4} %",
+                v * 100.0,
+                vtol * 100.0
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The vibration moments of orders 0 … `derivatives` vanish at every mode (each scaled by
+/// the duration to its order).
+fn verify_zero_moments(shaper: &Shaper, modes: &[Mode], derivatives: u32) -> Result<()> {
+    let t_n = shaper.duration().max(f64::MIN_POSITIVE);
+    for (i, mode) in modes.iter().enumerate() {
+        for k in 0..=derivatives {
+            let [c, s] = crate::vibration::vibration_moment(
+                shaper.impulses(),
+                mode.omega_rad_s(),
+                mode.damping(),
+                k,
+            );
+            let m = c.hypot(s) / t_n.powi(k as i32);
+            if m.is_nan() || m > ZERO_VIBRATION_TOLERANCE {
+                return Err(Error::Infeasible {
+                    reason: format!(
+                        "the designed shaper leaves a vibration moment of order {k} of {m:.3e} \
+                         at modes[{i}] ({} Hz, ζ = {})",
+                        mode.frequency_hz(),
+                        mode.damping()
+                    ),
+                });
             }
         }
-        Guarantee::ZeroAtModes => {
-            for (i, mode) in modes.iter().enumerate() {
-                // From the impulses themselves, not the convolution factors the design used.
-                let v = crate::vibration::vibration_rad(
-                    shaper.impulses(),
-                    mode.omega_rad_s(),
-                    mode.damping(),
-                );
-                if v.is_nan() || v > ZERO_VIBRATION_TOLERANCE {
-                    return Err(Error::Infeasible {
-                        reason: format!(
-                            "the designed shaper leaves V = {v:.3e} at modes[{i}] ({} Hz, ζ = {}): \
-                             the mode is too close to the numerical limits",
-                            mode.frequency_hz(),
-                            mode.damping()
-                        ),
-                    });
-                }
-            }
+    }
+    Ok(())
+}
+
+/// V vanishes at every mode, from the impulses themselves (not the convolution factors the
+/// design used).
+fn verify_zero_at_modes(shaper: &Shaper, modes: &[Mode]) -> Result<()> {
+    for (i, mode) in modes.iter().enumerate() {
+        let v =
+            crate::vibration::vibration_rad(shaper.impulses(), mode.omega_rad_s(), mode.damping());
+        if v.is_nan() || v > ZERO_VIBRATION_TOLERANCE {
+            return Err(Error::Infeasible {
+                reason: format!(
+                    "the designed shaper leaves V = {v:.3e} at modes[{i}] ({} Hz, ζ = {}): \
+                     the mode is too close to the numerical limits",
+                    mode.frequency_hz(),
+                    mode.damping()
+                ),
+            });
         }
     }
     Ok(())

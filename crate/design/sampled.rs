@@ -232,71 +232,45 @@ fn optional_finite(field: &str, value: Option<f64>) -> Result<Option<f64>> {
     value.map(|v| finite(field, v)).transpose()
 }
 
-impl Problem {
-    /// Validates `spec` for `mode`. Errors name the spec field (`periodS`, `impulses`,
-    /// `delaySamples`, `weight`, `derivatives`, `plantGain`, `amplitudeMin`, …).
-    pub fn new(mode: &Mode, spec: &SampledSpec) -> Result<Problem> {
-        let period = finite("periodS", spec.period_s)?;
-        if period <= 0.0 {
+/// The number of impulses: at least one per row of eq. 13 (the derivatives, within
+/// [`MAX_DERIVATIVES`], and the delay add rows), at most [`MAX_IMPULSES`]; the ramp delay
+/// must end within the shaper.
+fn impulse_count(spec: &SampledSpec) -> Result<usize> {
+    if spec.derivatives > MAX_DERIVATIVES {
+        return Err(Error::TooLarge {
+            field: "derivatives".into(),
+            value: f64::from(spec.derivatives),
+            limit: f64::from(MAX_DERIVATIVES),
+        });
+    }
+    let rows =
+        MIN_IMPULSES + 2 * spec.derivatives as usize + usize::from(spec.delay_samples.is_some());
+    let n = count("impulses", spec.impulses, rows, MAX_IMPULSES).map_err(|e| match e {
+        Error::InvalidInput { field, reason } => Error::InvalidInput {
+            field,
+            reason: format!("{reason} (one per row of eq. 13 asked for)"),
+        },
+        e => e,
+    })?;
+    if let Some(m) = spec.delay_samples {
+        if m as usize > n - 1 {
             return Err(Error::invalid(
-                "periodS",
-                format!("must be greater than 0 s, got {period}"),
+                "delaySamples",
+                format!(
+                    "the ramp delay must end within the shaper: at most impulses − 1 = {}, \
+                     got {m}",
+                    n - 1
+                ),
             ));
         }
-        if spec.derivatives > MAX_DERIVATIVES {
-            return Err(Error::TooLarge {
-                field: "derivatives".into(),
-                value: f64::from(spec.derivatives),
-                limit: f64::from(MAX_DERIVATIVES),
-            });
-        }
-        let rows = MIN_IMPULSES
-            + 2 * spec.derivatives as usize
-            + usize::from(spec.delay_samples.is_some());
-        let n = count("impulses", spec.impulses, rows, MAX_IMPULSES).map_err(|e| match e {
-            Error::InvalidInput { field, reason } => Error::InvalidInput {
-                field,
-                reason: format!("{reason} (one per row of eq. 13 asked for)"),
-            },
-            e => e,
-        })?;
-        if let Some(m) = spec.delay_samples {
-            if m as usize > n - 1 {
-                return Err(Error::invalid(
-                    "delaySamples",
-                    format!(
-                        "the ramp delay must end within the shaper: at most impulses − 1 = {}, \
-                         got {m}",
-                        n - 1
-                    ),
-                ));
-            }
-        }
-        let weight = finite("weight", spec.weight)?;
-        if weight < 0.0 {
-            return Err(Error::invalid(
-                "weight",
-                format!("must be ≥ 0, got {weight}"),
-            ));
-        }
-        if weight > MAX_WEIGHT {
-            return Err(Error::TooLarge {
-                field: "weight".into(),
-                value: weight,
-                limit: MAX_WEIGHT,
-            });
-        }
-        let omega = mode.omega_rad_s();
-        let gain = match spec.plant_gain {
-            Some(k) => {
-                finite("plantGain", k)?;
-                if k < 0.0 {
-                    return Err(Error::invalid("plantGain", format!("must be ≥ 0, got {k}")));
-                }
-                k
-            }
-            None => 1.0 / (omega * omega),
-        };
+    }
+    Ok(n)
+}
+
+impl Bounds {
+    /// The spec's bounds: finite, each pair ordered, and the amplitude bounds leaving room for
+    /// `n` impulses to sum to 1.
+    fn new(spec: &SampledSpec, n: usize) -> Result<Bounds> {
         let bounds = Bounds {
             amplitude_min: optional_finite("amplitudeMin", spec.amplitude_min)?,
             amplitude_max: optional_finite("amplitudeMax", spec.amplitude_max)?,
@@ -338,6 +312,47 @@ impl Problem {
                 });
             }
         }
+        Ok(bounds)
+    }
+}
+
+impl Problem {
+    /// Validates `spec` for `mode`. Errors name the spec field (`periodS`, `impulses`,
+    /// `delaySamples`, `weight`, `derivatives`, `plantGain`, `amplitudeMin`, …).
+    pub fn new(mode: &Mode, spec: &SampledSpec) -> Result<Problem> {
+        let period = finite("periodS", spec.period_s)?;
+        if period <= 0.0 {
+            return Err(Error::invalid(
+                "periodS",
+                format!("must be greater than 0 s, got {period}"),
+            ));
+        }
+        let n = impulse_count(spec)?;
+        let weight = finite("weight", spec.weight)?;
+        if weight < 0.0 {
+            return Err(Error::invalid(
+                "weight",
+                format!("must be ≥ 0, got {weight}"),
+            ));
+        }
+        if weight > MAX_WEIGHT {
+            return Err(Error::TooLarge {
+                field: "weight".into(),
+                value: weight,
+                limit: MAX_WEIGHT,
+            });
+        }
+        let omega = mode.omega_rad_s();
+        let gain = match spec.plant_gain {
+            Some(k) => {
+                finite("plantGain", k)?;
+                if k < 0.0 {
+                    return Err(Error::invalid("plantGain", format!("must be ≥ 0, got {k}")));
+                }
+                k
+            }
+            None => 1.0 / (omega * omega),
+        };
         Ok(Problem {
             n,
             period,
@@ -348,7 +363,7 @@ impl Problem {
             zeta: mode.damping(),
             omega,
             objective: spec.objective,
-            bounds,
+            bounds: Bounds::new(spec, n)?,
         })
     }
 
@@ -650,6 +665,41 @@ fn bounded_qp(
     g: &DMatrix<f64>,
     hb: &DVector<f64>,
 ) -> Result<DVector<f64>> {
+    let x0 = interior_point_qp(h, f, c, b, g, hb)?;
+    if let Some(x) = active_set(h, f, c, b, g, hb, &x0) {
+        return Ok(x);
+    }
+    // The loop did not settle (degenerate bounds): project clarabel's point onto C x = b and
+    // accept it if the bounds still hold.
+    let cct = c * c.transpose();
+    let correction = cct
+        .lu()
+        .solve(&(c * &x0 - b))
+        .map(|y| c.transpose() * y)
+        .ok_or_else(|| Error::Infeasible {
+            reason: "the constraints of eq. 13 are singular".into(),
+        })?;
+    let x = x0 - correction;
+    if max_violation(g, hb, &x) <= 1e-7 {
+        Ok(x)
+    } else {
+        Err(Error::Infeasible {
+            reason: "the bounded QP could not be solved to the accuracy eq. 13 needs".into(),
+        })
+    }
+}
+
+/// Clarabel's solution of min ½xᵀHx − fᵀx subject to C x = b, G x ≤ hb (an interior point,
+/// accurate to the solver's tolerance); an error if it is infeasible or the solver stops.
+#[cfg(feature = "solver")]
+fn interior_point_qp(
+    h: &DMatrix<f64>,
+    f: &DVector<f64>,
+    c: &DMatrix<f64>,
+    b: &DVector<f64>,
+    g: &DMatrix<f64>,
+    hb: &DVector<f64>,
+) -> Result<DVector<f64>> {
     use clarabel::solver::{
         DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
     };
@@ -694,8 +744,26 @@ fn bounded_qp(
             })
         }
     }
-    let x0 = DVector::from_column_slice(&solver.solution.x);
-    let slack = hb - g * &x0;
+    Ok(DVector::from_column_slice(&solver.solution.x))
+}
+
+/// The active-set loop from clarabel's point `x0`: the bounds nearly active there form the
+/// working set; the equality QP with them is solved exactly, a violated bound is added, a
+/// bound with a multiplier of the wrong sign dropped, until neither happens (at most
+/// [`MAX_ACTIVE_SET_STEPS`] times). `None` if it does not settle.
+#[cfg(feature = "solver")]
+fn active_set(
+    h: &DMatrix<f64>,
+    f: &DVector<f64>,
+    c: &DMatrix<f64>,
+    b: &DVector<f64>,
+    g: &DMatrix<f64>,
+    hb: &DVector<f64>,
+    x0: &DVector<f64>,
+) -> Option<DVector<f64>> {
+    let n = h.nrows();
+    let (r, p) = (c.nrows(), g.nrows());
+    let slack = hb - g * x0;
     let mut working: Vec<usize> = (0..p)
         .filter(|&j| slack[j] <= 1e-6 * (1.0 + hb[j].abs()))
         .collect();
@@ -708,9 +776,7 @@ fn bounded_qp(
             e.row_mut(r + k).copy_from(&g.row(j));
             d[r + k] = hb[j];
         }
-        let Some((x, nu)) = equality_qp(h, f, &e, &d) else {
-            break;
-        };
+        let (x, nu) = equality_qp(h, f, &e, &d)?;
         let gx = g * &x;
         let worst = (0..p)
             .filter(|j| !working.contains(j))
@@ -737,26 +803,9 @@ fn bounded_qp(
                 x[i] = hb[j] / coefficient;
             }
         }
-        return Ok(x);
+        return Some(x);
     }
-    // The loop did not settle (degenerate bounds): project clarabel's point onto C x = b and
-    // accept it if the bounds still hold.
-    let cct = c * c.transpose();
-    let correction = cct
-        .lu()
-        .solve(&(c * &x0 - b))
-        .map(|y| c.transpose() * y)
-        .ok_or_else(|| Error::Infeasible {
-            reason: "the constraints of eq. 13 are singular".into(),
-        })?;
-    let x = x0 - correction;
-    if max_violation(g, hb, &x) <= 1e-7 {
-        Ok(x)
-    } else {
-        Err(Error::Infeasible {
-            reason: "the bounded QP could not be solved to the accuracy eq. 13 needs".into(),
-        })
-    }
+    None
 }
 
 /// A column-compressed matrix from a dense generator, skipping zeros.
