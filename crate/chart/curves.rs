@@ -36,20 +36,10 @@ pub(super) fn draw_vibration_curves<DB: DrawingBackend>(
         .clamp(1e-3, super::AXIS_LIMIT)
         * 100.0
         * 1.06;
-    let mut chart = ChartBuilder::on(area)
-        .caption(axis.caption, ("sans-serif", style.font(16.0)))
-        .margin(style.px(10.0))
-        .x_label_area_size(style.px(40.0))
-        .y_label_area_size(style.px(52.0))
+    let mut chart = super::framed(area, axis.caption, 52.0, style)
         .build_cartesian_2d(f_lo..f_hi, 0.0..v_max)
         .map_err(render_error)?;
-    chart
-        .configure_mesh()
-        .x_desc(axis.x_desc)
-        .y_desc("vibration (%)")
-        .label_style(("sans-serif", style.font(12.0)))
-        .axis_desc_style(("sans-serif", style.font(13.0)))
-        .light_line_style(RGBColor(238, 238, 238))
+    super::mesh(&mut chart, axis.x_desc, "vibration (%)", style)
         .draw()
         .map_err(render_error)?;
     let marker = RGBColor(120, 120, 120);

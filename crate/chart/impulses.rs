@@ -29,20 +29,10 @@ pub fn draw_impulses<DB: DrawingBackend>(
         .fold((0.0_f64, 0.0_f64), |(lo, hi), a| (lo.min(a), hi.max(a)));
     let pad = 0.12 * (a_max - a_min).max(1e-9);
     let x_pad = 0.06 * t_max;
-    let mut chart = ChartBuilder::on(area)
-        .caption("Impulse sequence", ("sans-serif", style.font(16.0)))
-        .margin(style.px(10.0))
-        .x_label_area_size(style.px(40.0))
-        .y_label_area_size(style.px(52.0))
+    let mut chart = super::framed(area, "Impulse sequence", 52.0, style)
         .build_cartesian_2d(-x_pad..t_max + x_pad, (a_min - pad).min(0.0)..a_max + pad)
         .map_err(render_error)?;
-    chart
-        .configure_mesh()
-        .x_desc("time (s)")
-        .y_desc("amplitude")
-        .label_style(("sans-serif", style.font(12.0)))
-        .axis_desc_style(("sans-serif", style.font(13.0)))
-        .light_line_style(RGBColor(238, 238, 238))
+    super::mesh(&mut chart, "time (s)", "amplitude", style)
         .draw()
         .map_err(render_error)?;
     chart
