@@ -61,7 +61,8 @@ test(`${STEPS} random inputs and hashes: no exception, never blank, last good re
       const buttons = await page.$$('button:not([disabled]):not(#copy-link):not(#export-copy):not(#save-state):not(#export-download):visible');
       if (buttons.length) await buttons[Math.floor(r() * buttons.length)].click();
     } else {
-      const inputs = await page.$$('input[type=number], input[type=text], select, textarea:not([readonly])');
+      // Only what a person can reach: the measured-data view's controls are hidden until it opens.
+      const inputs = await page.$$('input[type=number]:visible, input[type=text]:visible, select:visible, textarea:not([readonly]):visible');
       const input = inputs[Math.floor(r() * inputs.length)];
       const tag = await input.evaluate((e) => e.tagName);
       if (tag === 'SELECT') {
