@@ -320,3 +320,89 @@ fn recommend_criterion_optimal_ranks_the_optimised_shaper_first() {
     assert!(score(0) <= pick.klipper_score.unwrap());
     assert!(r.note.as_deref().is_some_and(|n| !n.is_empty()));
 }
+
+/// The score table of docs/measured-data.md (*Scores on the test set*): every
+/// `resonances_*.csv`, RepRapFirmware limits, the custom method from `OPTIMAL_METHOD`
+/// (`continuation` by default, `grid`, `both`). Prints markdown rows and the medians.
+/// `cargo test --release --test optimal -- --ignored --nocapture score_table`.
+#[test]
+#[ignore = "prints the docs' table (slow in debug builds)"]
+fn score_table() {
+    use input_shaping::measure::optimal::CustomMethod;
+    let method = match std::env::var("OPTIMAL_METHOD").as_deref() {
+        Ok("grid") => CustomMethod::Grid,
+        Ok("both") => CustomMethod::Both,
+        _ => CustomMethod::Continuation,
+    };
+    let mut names: Vec<String> = std::fs::read_dir(DIR)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.starts_with("resonances_") && n.ends_with(".csv"))
+        .collect();
+    names.sort();
+    let (mut main_gain, mut custom_gain) = (Vec::new(), Vec::new());
+    println!(
+        "| file | Klipper's pick | score / R / smoothing | best mainline | score / R / smoothing \
+         | custom | score / R / smoothing | ms |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
+    for name in &names {
+        let data = read(name);
+        let options = OptimalOptions {
+            firmware: Firmware::Reprapfirmware,
+            custom_method: method,
+            ..OptimalOptions::default()
+        };
+        let t0 = std::time::Instant::now();
+        let r = optimal(&data, &[], &options).unwrap();
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        let cell = |i: usize| {
+            let row = &r.rows[i];
+            let change = if i == 0 {
+                String::new()
+            } else {
+                format!(" ({:+.1} %)", -100.0 * row.improvement)
+            };
+            format!(
+                "{:.6}{change} / {:.2} % / {:.4}",
+                row.klipper.score,
+                100.0 * row.klipper.vibrations,
+                row.klipper.smoothing
+            )
+        };
+        let label = |i: usize| {
+            let row = &r.rows[i];
+            match (i, row.shaper_freq_hz, row.damping_ratio) {
+                (0, Some(f), _) => format!("{} {f:.1} Hz", row.family),
+                (_, Some(f), Some(z)) => format!("{} {f:.2} Hz ζ {z:.3}", row.family),
+                _ => format!("custom ({} imp.)", row.shaper.impulses.len()),
+            }
+        };
+        println!(
+            "| {name} | {} | {} | {} | {} | {} | {} | {ms:.0} |",
+            label(0),
+            cell(0),
+            label(1),
+            cell(1),
+            label(2),
+            cell(2)
+        );
+        main_gain.push(r.rows[1].improvement);
+        custom_gain.push(r.rows[2].improvement);
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let n = v.len();
+        if n % 2 == 1 {
+            v[n / 2]
+        } else {
+            0.5 * (v[n / 2 - 1] + v[n / 2])
+        }
+    };
+    println!(
+        "median improvement over Klipper's pick ({} files): mainline {:.1} %, custom {:.1} %",
+        names.len(),
+        100.0 * median(&mut main_gain),
+        100.0 * median(&mut custom_gain)
+    );
+}

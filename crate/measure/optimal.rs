@@ -112,46 +112,18 @@ pub enum Firmware {
     Reprapfirmware,
 }
 
-/// What a firmware's custom shaper accepts.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(rename_all = "camelCase")]
-pub struct FirmwareLimits {
-    /// Most impulses.
-    pub max_impulses: usize,
-    /// Longest shaper (last impulse time), s.
-    pub max_duration_s: f64,
-    /// Shortest shaper with more than one impulse, s.
-    pub min_duration_s: f64,
-    /// Smallest amplitude (after normalising to Σ A = 1).
-    pub min_amplitude: f64,
-}
+pub use crate::firmware_limits::FirmwareLimits;
 
 impl Firmware {
     /// The firmware's custom-shaper limits; `None` for mainline Klipper (no custom shaper).
-    ///
-    /// - Kalico: klippy/extras/input_shaper.py `CustomInputShaperParams._parse_custom_shaper`
-    ///   (every |A| ≥ 0.001, Σ A ≥ 0.001, T sorted, 0.001 s ≤ duration ≤ 0.2 s) and
-    ///   klippy/chelper/kin_shaper.c `struct shaper_pulses` (at most 25 pulses). Kalico also
-    ///   takes negative amplitudes; the optimiser here keeps them positive.
-    /// - RepRapFirmware: src/Movement/AxisShaper.h `MaxExtraImpulses = 4` (so 5 impulses) and
-    ///   AxisShaper.cpp `Configure` (`H` read as at most 4 values, `T` as many); amplitudes
-    ///   positive ([`crate::export::to_rrf_m593`] refuses others). RRF states no duration
-    ///   bound; Kalico's 0.2 s is used for it too.
+    /// The numbers and their citations (Kalico's `_parse_custom_shaper` and kin_shaper.c,
+    /// RepRapFirmware's AxisShaper.h) are in [`crate::firmware_limits`], which the config
+    /// writer checks against too.
     pub fn limits(self) -> Option<FirmwareLimits> {
         match self {
             Firmware::Klipper => None,
-            Firmware::Kalico => Some(FirmwareLimits {
-                max_impulses: 25,
-                max_duration_s: 0.2,
-                min_duration_s: 0.001,
-                min_amplitude: 0.001,
-            }),
-            Firmware::Reprapfirmware => Some(FirmwareLimits {
-                max_impulses: 5,
-                max_duration_s: 0.2,
-                min_duration_s: 0.001,
-                min_amplitude: 0.001,
-            }),
+            Firmware::Kalico => Some(crate::firmware_limits::KALICO_CUSTOM),
+            Firmware::Reprapfirmware => Some(crate::firmware_limits::RRF_CUSTOM),
         }
     }
 }
