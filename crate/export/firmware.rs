@@ -265,6 +265,48 @@ impl Axis {
     }
 }
 
+/// The named family of `a` (`None` for `custom`), or an error naming `field.family`.
+fn family_of(a: &AxisShaper, field: &str) -> Result<Option<&'static Family>> {
+    let family_name = a.family.to_ascii_lowercase();
+    if family_name == "custom" {
+        return Ok(None);
+    }
+    FAMILIES
+        .iter()
+        .find(|f| f.name == family_name)
+        .map(Some)
+        .ok_or_else(|| {
+            Error::invalid(
+                format!("{field}.family"),
+                format!(
+                    "unknown shaper family {:?}; expected {KLIPPER_TYPES}, zvdd, zvddd or custom",
+                    a.family
+                ),
+            )
+        })
+}
+
+/// The frequency of `a`: finite and > 0 when given, required for a named family.
+fn frequency_of(a: &AxisShaper, family: Option<&Family>, field: &str) -> Result<Option<f64>> {
+    match (a.frequency_hz, family) {
+        (Some(f), _) => {
+            finite(&format!("{field}.frequencyHz"), f)?;
+            if f <= 0.0 {
+                return Err(Error::invalid(
+                    format!("{field}.frequencyHz"),
+                    format!("must be greater than 0 Hz (0 turns shaping off), got {f}"),
+                ));
+            }
+            Ok(Some(f))
+        }
+        (None, Some(fam)) => Err(Error::invalid(
+            format!("{field}.frequencyHz"),
+            format!("the {} shaper needs its frequency", fam.name),
+        )),
+        (None, None) => Ok(None),
+    }
+}
+
 /// Validates the axes; `allowed` are the firmware's axis names.
 fn check(axes: &[AxisShaper], allowed: &[&str], firmware: &str) -> Result<Vec<Axis>> {
     if axes.is_empty() {
@@ -290,45 +332,8 @@ fn check(axes: &[AxisShaper], allowed: &[&str], firmware: &str) -> Result<Vec<Ax
                 format!("axis {name} is given twice"),
             ));
         }
-        let family_name = a.family.to_ascii_lowercase();
-        let family = if family_name == "custom" {
-            None
-        } else {
-            Some(
-                FAMILIES
-                    .iter()
-                    .find(|f| f.name == family_name)
-                    .ok_or_else(|| {
-                        Error::invalid(
-                            format!("{field}.family"),
-                            format!(
-                                "unknown shaper family {:?}; expected {KLIPPER_TYPES}, zvdd, \
-                                 zvddd or custom",
-                                a.family
-                            ),
-                        )
-                    })?,
-            )
-        };
-        let frequency = match a.frequency_hz {
-            Some(f) => {
-                finite(&format!("{field}.frequencyHz"), f)?;
-                if f <= 0.0 {
-                    return Err(Error::invalid(
-                        format!("{field}.frequencyHz"),
-                        format!("must be greater than 0 Hz (0 turns shaping off), got {f}"),
-                    ));
-                }
-                Some(f)
-            }
-            None if family.is_some() => {
-                return Err(Error::invalid(
-                    format!("{field}.frequencyHz"),
-                    format!("the {family_name} shaper needs its frequency"),
-                ))
-            }
-            None => None,
-        };
+        let family = family_of(a, &field)?;
+        let frequency = frequency_of(a, family, &field)?;
         finite(&format!("{field}.damping"), a.damping)?;
         if !(0.0..1.0).contains(&a.damping) {
             return Err(Error::invalid(

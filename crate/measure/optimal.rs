@@ -849,28 +849,11 @@ fn own_figures(shaper: &Shaper, data: &CalibrationData, scv: f64) -> Result<Figu
     })
 }
 
-/// Klipper's pick, the best mainline-Klipper shaper and (for a custom-shaper firmware) the best
-/// custom shaper for Klipper's calibration `data` (normalised as Klipper scores it: see
-/// [`CalibrationData::normalize_to_frequencies`]; several runs are pessimised over, as Klipper
-/// does), with the robust score widened by `modes` (may be empty: Klipper's damping set then).
-/// See the module docs.
-///
-/// Errors: a run whose PSD is zero up to 200 Hz, a bad mode (`modes[i]…`),
-/// `uncertaintySigmas` outside [0, 10], Klipper's fit's errors.
-pub fn optimal(
-    data: &CalibrationData,
-    modes: &[MeasuredMode],
-    options: &OptimalOptions,
-) -> Result<OptimalReport> {
-    let runs = prepared(data)?;
-    let k = options.uncertainty_sigmas;
-    if !(0.0..=10.0).contains(&k) {
-        return Err(Error::invalid(
-            "uncertaintySigmas",
-            format!("must lie in [0, 10], got {k}"),
-        ));
-    }
-    finite("scv", options.scv)?;
+/// The robust score's damping ratios (Klipper's three, and ζ − kσ, ζ, ζ + kσ of every mode,
+/// sorted, deduplicated) and frequency factors (for the mainline search: 1 ± kσ_f/f when the
+/// modes carry a frequency uncertainty, else 1 alone; for the custom search: the same band,
+/// at least [`DEFAULT_FREQUENCY_BAND`]). Errors name the bad mode (`modes[i]…`).
+fn robust_sets(modes: &[MeasuredMode], k: f64) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
     count("modes", modes.len(), 0, super::identify::MAX_MODES)?;
     let mut damping: Vec<f64> = KLIPPER_TEST_DAMPING.to_vec();
     let mut rel_f: f64 = 0.0;
@@ -894,7 +877,83 @@ pub fn optimal(
         vec![1.0]
     };
     let d = rel_f.clamp(DEFAULT_FREQUENCY_BAND, 0.5);
-    let custom_factors = vec![1.0 - d, 1.0, 1.0 + d];
+    Ok((damping, mainline_factors, vec![1.0 - d, 1.0, 1.0 + d]))
+}
+
+/// The best custom shaper within `limits` on `custom_scorer` (the robust score with the
+/// custom frequency band), started from the `mainlines` (best first); the best mainline shaper
+/// when no custom one is admissible.
+fn custom_for(
+    custom_scorer: &Scorer,
+    limits: FirmwareLimits,
+    mainlines: &[Mainline],
+    bounds: Bounds,
+    options: &OptimalOptions,
+) -> Result<Shaper> {
+    let starts: Vec<Mainline> = mainlines
+        .iter()
+        .map(|m| -> Result<Mainline> {
+            Ok(Mainline {
+                eval: custom_scorer.eval(&m.shaper, true)?,
+                ..m.clone()
+            })
+        })
+        .collect::<Result<_>>()?;
+    let main = &mainlines[0];
+    let custom_bounds = Bounds {
+        score: bounds.score.min(main.eval.own_score()),
+        vibrations: bounds.vibrations,
+    };
+    let custom = best_custom(
+        custom_scorer,
+        custom_bounds,
+        limits,
+        &starts,
+        options.custom_method,
+    )?;
+    Ok(custom.map_or_else(|| main.shaper.clone(), |c| c.shaper))
+}
+
+/// The note's sentence on the custom shaper: plainly a small gain below [`SMALL_GAIN`].
+fn custom_note(gain_over_main: f64, improvement: f64) -> String {
+    if gain_over_main < SMALL_GAIN {
+        format!(
+            " The custom shaper buys little: {:.1} % lower score than the best mainline \
+             shaper; the mainline one is as good in practice.",
+            100.0 * gain_over_main
+        )
+    } else {
+        format!(
+            " The custom shaper scores a further {:.1} % lower ({:.1} % below Klipper's pick).",
+            100.0 * gain_over_main,
+            100.0 * improvement
+        )
+    }
+}
+
+/// Klipper's pick, the best mainline-Klipper shaper and (for a custom-shaper firmware) the best
+/// custom shaper for Klipper's calibration `data` (normalised as Klipper scores it: see
+/// [`CalibrationData::normalize_to_frequencies`]; several runs are pessimised over, as Klipper
+/// does), with the robust score widened by `modes` (may be empty: Klipper's damping set then).
+/// See the module docs.
+///
+/// Errors: a run whose PSD is zero up to 200 Hz, a bad mode (`modes[i]…`),
+/// `uncertaintySigmas` outside [0, 10], Klipper's fit's errors.
+pub fn optimal(
+    data: &CalibrationData,
+    modes: &[MeasuredMode],
+    options: &OptimalOptions,
+) -> Result<OptimalReport> {
+    let runs = prepared(data)?;
+    let k = options.uncertainty_sigmas;
+    if !(0.0..=10.0).contains(&k) {
+        return Err(Error::invalid(
+            "uncertaintySigmas",
+            format!("must lie in [0, 10], got {k}"),
+        ));
+    }
+    finite("scv", options.scv)?;
+    let (damping, mainline_factors, custom_factors) = robust_sets(modes, k)?;
 
     let scorer = Scorer::new(&runs, &damping, &mainline_factors, options.scv);
     let pick = klipper_pick(&scorer, data, options.scv)?;
@@ -934,33 +993,10 @@ pub fn optimal(
     );
     if let Some(limits) = options.firmware.limits() {
         let custom_scorer = Scorer::new(&runs, &damping, &custom_factors, options.scv);
-        let starts: Vec<Mainline> = mainlines
-            .iter()
-            .map(|m| -> Result<Mainline> {
-                Ok(Mainline {
-                    eval: custom_scorer.eval(&m.shaper, true)?,
-                    ..m.clone()
-                })
-            })
-            .collect::<Result<_>>()?;
-        let custom_bounds = Bounds {
-            score: bounds.score.min(main.eval.own_score()),
-            vibrations: bounds.vibrations,
-        };
-        let custom = best_custom(
-            &custom_scorer,
-            custom_bounds,
-            limits,
-            &starts,
-            options.custom_method,
-        )?;
+        let shaper = custom_for(&custom_scorer, limits, &mainlines, bounds, options)?;
         scorer
             .evaluations
             .set(scorer.evaluations.get() + custom_scorer.evaluations.get());
-        let (shaper, _) = match custom {
-            Some(c) => (c.shaper, c.eval),
-            None => (main.shaper.clone(), main.eval),
-        };
         let e = scorer.eval(&shaper, true)?;
         let fig = own_figures(&shaper, data, options.scv)?;
         let gain_over_main = 1.0 - fig.score / rows[1].klipper.score;
@@ -976,19 +1012,7 @@ pub fn optimal(
             improvement: 1.0 - fig.score / bounds.score,
         });
         recommended = 2;
-        if gain_over_main < SMALL_GAIN {
-            note.push_str(&format!(
-                " The custom shaper buys little: {:.1} % lower score than the best mainline \
-                 shaper; the mainline one is as good in practice.",
-                100.0 * gain_over_main
-            ));
-        } else {
-            note.push_str(&format!(
-                " The custom shaper scores a further {:.1} % lower ({:.1} % below Klipper's pick).",
-                100.0 * gain_over_main,
-                100.0 * rows[2].improvement
-            ));
-        }
+        note.push_str(&custom_note(gain_over_main, rows[2].improvement));
     }
     Ok(OptimalReport {
         rows,

@@ -33,6 +33,110 @@ pub(super) struct Cones {
     pub(super) cases: Vec<(f64, f64)>,
 }
 
+/// The conic program's constraints `A x + s = b`, `s ∈ K` (x: the amplitudes on the grid, then
+/// the smoothing bound).
+struct Program {
+    a: CscMatrix<f64>,
+    b: Vec<f64>,
+    cones: Vec<SupportedConeT<f64>>,
+}
+
+/// Sparse triplets of the constraint matrix, its right-hand side, and the row count.
+#[derive(Default)]
+struct Triplets {
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    vals: Vec<f64>,
+    b: Vec<f64>,
+}
+
+impl Triplets {
+    fn push(&mut self, r: usize, c: usize, v: f64) {
+        if v != 0.0 {
+            self.rows.push(r);
+            self.cols.push(c);
+            self.vals.push(v);
+        }
+    }
+}
+
+/// The program of [`solve`] on the grid `times` (last = T) with centroid `centroid`, or `None`
+/// when a coefficient is not finite.
+fn program(
+    cones: &Cones,
+    times: &[f64],
+    centroid: f64,
+    scv: f64,
+    last_min: f64,
+) -> Option<Program> {
+    let n_amp = times.len();
+    let t_end = times[n_amp - 1];
+    let s_col = n_amp;
+    let mut t = Triplets::default();
+    // Zero cone: Σ A = 1, Σ A t / T = c / T.
+    let mut row = 0;
+    for (j, &tj) in times.iter().enumerate() {
+        t.push(row, j, 1.0);
+        t.push(row + 1, j, tj / t_end);
+    }
+    t.b.push(1.0);
+    t.b.push(centroid / t_end);
+    row += 2;
+    // Nonnegative: A ≥ 0 (the last ≥ last_min), s ≥ o180, s ≥ o90 (in mm, as Klipper's).
+    for j in 0..n_amp {
+        t.push(row, j, -1.0);
+        t.b.push(if j == n_amp - 1 { -last_min } else { 0.0 });
+        row += 1;
+    }
+    let half = 0.5 * crate::smoothing::KLIPPER_ACCEL;
+    for (j, &tj) in times.iter().enumerate() {
+        let d = tj - centroid;
+        t.push(row, j, half * d * d);
+        if tj >= centroid {
+            t.push(row + 1, j, SQRT_2 * (scv + half * d) * d);
+        }
+    }
+    t.push(row, s_col, -1.0);
+    t.push(row + 1, s_col, -1.0);
+    t.b.push(0.0);
+    t.b.push(0.0);
+    row += 2;
+    let n_nonneg = n_amp + 2;
+    // Second-order cones: (bound, Re, Im) of Klipper's V sum at each bin and case.
+    let mut n_soc = 0;
+    for &(zeta, factor) in &cones.cases {
+        let damped = (1.0 - zeta * zeta).sqrt();
+        for &(f, bound) in &cones.bins {
+            let w = 2.0 * PI * f * factor;
+            t.b.push(bound);
+            row += 1;
+            for (j, &tj) in times.iter().enumerate() {
+                let decay = (-zeta * w * (t_end - tj)).exp();
+                let (sn, cs) = (w * damped * tj).sin_cos();
+                t.push(row, j, -decay * cs);
+                t.push(row + 1, j, -decay * sn);
+            }
+            t.b.push(0.0);
+            t.b.push(0.0);
+            row += 2;
+            n_soc += 1;
+        }
+    }
+    if t.vals.iter().chain(t.b.iter()).any(|v| !v.is_finite()) {
+        return None;
+    }
+    let mut k = vec![
+        SupportedConeT::ZeroConeT(2),
+        SupportedConeT::NonnegativeConeT(n_nonneg),
+    ];
+    k.extend((0..n_soc).map(|_| SupportedConeT::SecondOrderConeT(3)));
+    Some(Program {
+        a: CscMatrix::new_from_triplets(row, n_amp + 1, t.rows, t.cols, t.vals),
+        b: t.b,
+        cones: k,
+    })
+}
+
 /// The least-smoothing amplitudes on the grid with R = 0, or `None` when infeasible.
 fn solve(
     cones: &Cones,
@@ -45,78 +149,11 @@ fn solve(
     let times: Vec<f64> = (0..n_amp)
         .map(|j| t_end * j as f64 / GRID_INTERVALS as f64)
         .collect();
-    let s_col = n_amp;
+    let prog = program(cones, &times, centroid, scv, last_min)?;
     let n = n_amp + 1;
-    let (mut rows, mut cols, mut vals, mut b) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let mut push = |r: usize, c: usize, v: f64, rows: &mut Vec<usize>| {
-        if v != 0.0 {
-            rows.push(r);
-            cols.push(c);
-            vals.push(v);
-        }
-    };
-    // Zero cone: Σ A = 1, Σ A t / T = c / T.
-    let mut row = 0;
-    for (j, &t) in times.iter().enumerate() {
-        push(row, j, 1.0, &mut rows);
-        push(row + 1, j, t / t_end, &mut rows);
-    }
-    b.push(1.0);
-    b.push(centroid / t_end);
-    row += 2;
-    // Nonnegative: A ≥ 0 (the last ≥ last_min), s ≥ o180, s ≥ o90 (in mm, as Klipper's).
-    for j in 0..n_amp {
-        push(row, j, -1.0, &mut rows);
-        b.push(if j == n_amp - 1 { -last_min } else { 0.0 });
-        row += 1;
-    }
-    let half = 0.5 * crate::smoothing::KLIPPER_ACCEL;
-    for (j, &t) in times.iter().enumerate() {
-        let d = t - centroid;
-        push(row, j, half * d * d, &mut rows);
-        if t >= centroid {
-            push(row + 1, j, SQRT_2 * (scv + half * d) * d, &mut rows);
-        }
-    }
-    push(row, s_col, -1.0, &mut rows);
-    push(row + 1, s_col, -1.0, &mut rows);
-    b.push(0.0);
-    b.push(0.0);
-    row += 2;
-    let n_nonneg = n_amp + 2;
-    // Second-order cones: (bound, Re, Im) of Klipper's V sum at each bin and case.
-    let mut n_soc = 0;
-    for &(zeta, factor) in &cones.cases {
-        let damped = (1.0 - zeta * zeta).sqrt();
-        for &(f, bound) in &cones.bins {
-            let w = 2.0 * PI * f * factor;
-            b.push(bound);
-            row += 1;
-            for (j, &t) in times.iter().enumerate() {
-                let decay = (-zeta * w * (t_end - t)).exp();
-                let (sn, cs) = (w * damped * t).sin_cos();
-                push(row, j, -decay * cs, &mut rows);
-                push(row + 1, j, -decay * sn, &mut rows);
-            }
-            b.push(0.0);
-            b.push(0.0);
-            row += 2;
-            n_soc += 1;
-        }
-    }
-    let m = row;
-    if vals.iter().chain(b.iter()).any(|v| !v.is_finite()) {
-        return None;
-    }
     let mut q = vec![0.0; n];
-    q[s_col] = 1.0;
+    q[n_amp] = 1.0;
     let p = CscMatrix::zeros((n, n));
-    let a = CscMatrix::new_from_triplets(m, n, rows, cols, vals);
-    let mut k = vec![
-        SupportedConeT::ZeroConeT(2),
-        SupportedConeT::NonnegativeConeT(n_nonneg),
-    ];
-    k.extend((0..n_soc).map(|_| SupportedConeT::SecondOrderConeT(3)));
     let settings = DefaultSettings {
         verbose: false,
         max_iter: 100,
@@ -126,7 +163,7 @@ fn solve(
         tol_feas: 1e-8,
         ..DefaultSettings::default()
     };
-    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &k, settings).ok()?;
+    let mut solver = DefaultSolver::new(&p, &q, &prog.a, &prog.b, &prog.cones, settings).ok()?;
     solver.solve();
     if !matches!(
         solver.solution.status,
