@@ -145,9 +145,22 @@ fn solve(
     scv: f64,
     last_min: f64,
 ) -> Option<Vec<Impulse>> {
-    let n_amp = GRID_INTERVALS + 1;
+    solve_on(cones, GRID_INTERVALS, t_end, centroid, scv, last_min).map(|(_, imps)| imps)
+}
+
+/// [`solve`] on `intervals` grid intervals; also the program's optimum (the least smoothing on
+/// the grid, mm, before merging).
+fn solve_on(
+    cones: &Cones,
+    intervals: usize,
+    t_end: f64,
+    centroid: f64,
+    scv: f64,
+    last_min: f64,
+) -> Option<(f64, Vec<Impulse>)> {
+    let n_amp = intervals + 1;
     let times: Vec<f64> = (0..n_amp)
-        .map(|j| t_end * j as f64 / GRID_INTERVALS as f64)
+        .map(|j| t_end * j as f64 / intervals as f64)
         .collect();
     let prog = program(cones, &times, centroid, scv, last_min)?;
     let n = n_amp + 1;
@@ -175,12 +188,13 @@ fn solve(
         .iter()
         .map(|a| a.max(0.0))
         .collect();
+    let least = solver.solution.x[n_amp];
     let grid = GridSolution {
         duration: t_end,
         times,
         amplitudes,
     };
-    Some(merge(&grid))
+    Some((least, merge(&grid)))
 }
 
 /// At most `max_n` impulses: the smallest dropped, the rest renormalised; `None` if fewer
@@ -221,4 +235,60 @@ pub(super) fn starts(
     }
     crate::sort::sort_by(&mut out, |a, b| a.0.total_cmp(&b.0));
     Ok(out.into_iter().map(|(_, s)| s).collect())
+}
+
+/// Grid intervals of [`least_smoothing`].
+const BOUND_INTERVALS: usize = 60;
+
+/// The least smoothing (mm) with no remaining vibration (R = 0) of any shaper whose impulses lie
+/// on a [`BOUND_INTERVALS`]-interval grid of its duration, whatever their number, the last
+/// carrying at least `last_min`: the program of [`solve`] minimised over the duration (from
+/// ½ to 3 times `duration`) and the centroid (0.2 to 0.6 of the duration), a coarse sweep then
+/// two finer ones around the best. Klipper's score of such a shaper is 0.01 × its smoothing,
+/// so 0.01 × this is the best score any R = 0 shaper on the grid reaches; `None` when no
+/// (duration, centroid) is feasible. Returns (smoothing, duration s, merged impulses).
+pub(super) fn least_smoothing(
+    cones: &Cones,
+    duration: f64,
+    scv: f64,
+    last_min: f64,
+) -> Option<(f64, f64, Vec<Impulse>)> {
+    let mut best: Option<(f64, f64, f64, Vec<Impulse>)> = None;
+    let try_at = |dt: f64, dc: f64, best: &mut Option<(f64, f64, f64, Vec<Impulse>)>| {
+        if !(0.05..=0.95).contains(&dc) || dt <= 0.0 {
+            return;
+        }
+        let t_end = dt * duration;
+        if let Some((s, imps)) = solve_on(cones, BOUND_INTERVALS, t_end, dc * t_end, scv, last_min)
+        {
+            if best.as_ref().is_none_or(|b| s < b.0) {
+                *best = Some((s, dt, dc, imps));
+            }
+        }
+    };
+    let (mut step_t, mut step_c) = (0.125, 0.05);
+    let mut dt = 0.5;
+    while dt <= 3.0 + 1e-9 {
+        let mut dc = 0.2;
+        while dc <= 0.6 + 1e-9 {
+            try_at(dt, dc, &mut best);
+            dc += step_c;
+        }
+        dt += step_t;
+    }
+    for _ in 0..2 {
+        let (t0, c0) = best.as_ref().map(|b| (b.1, b.2))?;
+        step_t /= 3.0;
+        step_c /= 3.0;
+        for i in -2..=2 {
+            for j in -2..=2 {
+                try_at(
+                    t0 + f64::from(i) * step_t,
+                    c0 + f64::from(j) * step_c,
+                    &mut best,
+                );
+            }
+        }
+    }
+    best.map(|(s, dt, _, imps)| (s, dt * duration, imps))
 }
