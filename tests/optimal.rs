@@ -389,6 +389,7 @@ fn score_table() {
         );
         main_gain.push(r.rows[1].improvement);
         custom_gain.push(r.rows[2].improvement);
+        #[cfg(feature = "solver")]
         if std::env::var("OPTIMAL_BOUND").is_ok() {
             use input_shaping::measure::optimal::no_vibration_bound;
             for last_min in [0.0, MIN_CUSTOM_AMPLITUDE] {
@@ -424,6 +425,7 @@ fn score_table() {
     );
 }
 
+#[cfg(feature = "solver")]
 #[test]
 fn no_vibration_bound_is_a_floor_below_klippers_pick() {
     // The convex grid program's least smoothing with R = 0 (last impulse ≥ 2 %): Klipper's
