@@ -5,6 +5,9 @@
 //
 //   bash scripts/build.sh   # or any --target web build of the js-recording feature
 //   node benches/klipper_wasm.mjs [path/to/recording.js] [files…]
+//   CRITERION=optimal FIRMWARE=reprapfirmware node benches/klipper_wasm.mjs …
+//                           # issue 25: the optimised shapers (Klipper's pick, best mainline,
+//                           # best custom: the page's continuation), per axis
 //
 // Prints, per file, the median and minimum of 20 runs after 3 warm-ups (wall clock and the
 // process's CPU time, which a busy machine inflates less), and the pick.
@@ -19,6 +22,8 @@ const files = args.length > 1 ? args.slice(1) : [
   'resonances_x_m1.csv', 'resonances_x_z018f61.csv', 'resonances_y_z020f61.csv',
   'calibration_data_x_m1.csv',
 ];
+const criterion = process.env.CRITERION ?? 'klipper';
+const firmware = process.env.FIRMWARE ?? 'klipper';
 const mod = await import(modulePath);
 const wasm = readFileSync(modulePath.replace(/\.js$/, '_bg.wasm'));
 await mod.default({ module_or_path: wasm });
@@ -38,7 +43,8 @@ function read(name) {
 
 for (const name of files) {
   const spectrum = read(name);
-  const run = () => mod.recommendShaper(spectrum, [], { criterion: 'klipper' });
+  const options = criterion === 'optimal' ? { criterion, firmware } : { criterion };
+  const run = () => mod.recommendShaper(spectrum, [], options);
   for (let i = 0; i < 3; i++) run();
   const times = [];
   const cpu = [];
@@ -53,8 +59,10 @@ for (const name of files) {
   }
   times.sort((a, b) => a - b);
   cpu.sort((a, b) => a - b);
-  const best = r.klipper.families[r.klipper.best];
+  const pick = criterion === 'optimal'
+    ? `${r.ranked[0].label}, score ${r.ranked[0].klipperScore.toPrecision(4)}`
+    : (({ name, printed }) => `${name} @ ${printed.freq} Hz`)(r.klipper.families[r.klipper.best]);
   console.log(`${name}: median ${times[10].toFixed(1)} ms, min ${times[0].toFixed(1)} ms `
     + `(CPU time: median ${cpu[10].toFixed(1)} ms, min ${cpu[0].toFixed(1)} ms) `
-    + `(${spectrum.frequencyHz.length} bins) → ${best.name} @ ${best.printed.freq} Hz`);
+    + `(${spectrum.frequencyHz.length} bins) → ${pick}`);
 }

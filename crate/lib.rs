@@ -21,6 +21,8 @@
 //! - [`design`](mod@design): the spec, the table of families, and one file per family of the literature.
 //! - [`smoothing`]: Klipper-compatible smoothing and suggested maximum acceleration.
 //! - [`export`]: CSV, JSON, C arrays and RepRapFirmware `M593` lines.
+//! - [`firmware_limits`]: what each firmware's shaper accepts (impulses, duration, amplitudes,
+//!   frequency), cited from its source; read by the optimiser and the config writer.
 //! - [`command`]: reference commands (step, ramp, trapezoid, S-curve, sampled) and shaping
 //!   them (exact convolution, streaming filter).
 //! - [`profile`]: pulse-convolution profiles and their B-spline form (Veciana & Cardona 2011).
@@ -48,7 +50,7 @@
 //! listed here.
 //!
 //! ```text
-//! ground     error mode shaper sort tagged
+//! ground     error mode shaper sort tagged firmware_limits
 //! analysis   vibration smoothing
 //! numerics   solve
 //! design     design
@@ -70,6 +72,7 @@ pub mod command;
 pub mod design;
 pub mod error;
 pub mod export;
+pub mod firmware_limits;
 pub mod measure;
 pub mod metrics;
 pub mod mode;

@@ -3,7 +3,8 @@
 //! RepRapFirmware's `M593`, and Marlin's `M593 X F… D…`.
 //!
 //! Every limit checked here is the firmware's own, read from its source (GPL: read and cited,
-//! not copied); the citations are on the constants. A shaper a firmware cannot express is an
+//! not copied); the constants and their citations live in [`crate::firmware_limits`], shared
+//! with the optimiser, and are re-exported here. A shaper a firmware cannot express is an
 //! [`Error`] naming the axis field, the firmware and the limit; nothing is truncated or
 //! silently replaced. Values are checked *as written*: each number is formatted, read back and
 //! the firmware's limit applied to what the firmware will read.
@@ -44,30 +45,11 @@ use std::fmt::Write;
 
 /// Klipper's default damping ratio (klippy/extras/shaper_defs.py, `DEFAULT_DAMPING_RATIO`).
 pub const KLIPPER_DEFAULT_DAMPING: f64 = 0.1;
-/// Kalico's largest custom shaper: `struct shaper_pulses` holds `pulses[25]` and `init_shaper`
-/// refuses more (KalicoCrew/kalico, klippy/chelper/kin_shaper.c, `init_shaper`, at commit
-/// 197f6ff). dmbutyugin/klipper's branch holds 5 (klippy/chelper/kin_shaper.h).
-pub const KALICO_MAX_IMPULSES: usize = 25;
-/// Kalico rejects a custom amplitude of magnitude below this ("All shaper A coefficients must
-/// be non-zero", `_parse_custom_shaper`).
-pub const KALICO_MIN_ABS_AMPLITUDE: f64 = 0.001;
-/// Kalico rejects custom amplitudes summing below this (`_parse_custom_shaper`).
-pub const KALICO_MIN_AMPLITUDE_SUM: f64 = 0.001;
-/// Kalico rejects a custom shaper of several impulses shorter than this, s.
-pub const KALICO_MIN_DURATION_S: f64 = 0.001;
-/// Kalico rejects a custom shaper longer than this, s ("Shaper duration is too large").
-pub const KALICO_MAX_DURATION_S: f64 = 0.2;
-/// RepRapFirmware 3.6 holds at most 5 impulses (AxisShaper.h, `MaxImpulses`): `H` and `T`
-/// take at most 4 values each.
-pub const RRF_MAX_IMPULSES: usize = 5;
-/// Lowest `M593 F` accepted by every RRF 3.6 source read: AxisShaper.cpp limits F to
-/// [StepClockRate/(2·65535), 1000] Hz (half period in a 16-bit count of 750 kHz step clocks),
-/// the 3.6 header (rechrtb/RepRapFirmware 204471f, AxisShaper.h) to [4, 400] Hz.
-pub const RRF_MIN_FREQUENCY_HZ: f64 = 750_000.0 / (2.0 * 65535.0);
-/// Highest `M593 F` accepted by every RRF 3.6 source read (see [`RRF_MIN_FREQUENCY_HZ`]).
-pub const RRF_MAX_FREQUENCY_HZ: f64 = 400.0;
-/// RRF limits `M593 S` to [0, 0.99] (`GetLimitedFValue('S', 0.0, 0.99)`).
-pub const RRF_MAX_DAMPING: f64 = 0.99;
+pub use crate::firmware_limits::{
+    KALICO_MAX_DURATION_S, KALICO_MAX_IMPULSES, KALICO_MIN_ABS_AMPLITUDE, KALICO_MIN_AMPLITUDE_SUM,
+    KALICO_MIN_DURATION_S, RRF_MAX_DAMPING, RRF_MAX_FREQUENCY_HZ, RRF_MAX_IMPULSES,
+    RRF_MIN_FREQUENCY_HZ,
+};
 /// Marlin sizes its shaping buffer for `SHAPING_MIN_FREQ`, by default the lower of the built-in
 /// `SHAPING_FREQ_X`/`_Y`, 40 Hz in the shipped Configuration_adv.h; below it shaping loses
 /// effect at speed (Configuration_adv.h comments). A warning, not an error: builds differ.
@@ -283,6 +265,48 @@ impl Axis {
     }
 }
 
+/// The named family of `a` (`None` for `custom`), or an error naming `field.family`.
+fn family_of(a: &AxisShaper, field: &str) -> Result<Option<&'static Family>> {
+    let family_name = a.family.to_ascii_lowercase();
+    if family_name == "custom" {
+        return Ok(None);
+    }
+    FAMILIES
+        .iter()
+        .find(|f| f.name == family_name)
+        .map(Some)
+        .ok_or_else(|| {
+            Error::invalid(
+                format!("{field}.family"),
+                format!(
+                    "unknown shaper family {:?}; expected {KLIPPER_TYPES}, zvdd, zvddd or custom",
+                    a.family
+                ),
+            )
+        })
+}
+
+/// The frequency of `a`: finite and > 0 when given, required for a named family.
+fn frequency_of(a: &AxisShaper, family: Option<&Family>, field: &str) -> Result<Option<f64>> {
+    match (a.frequency_hz, family) {
+        (Some(f), _) => {
+            finite(&format!("{field}.frequencyHz"), f)?;
+            if f <= 0.0 {
+                return Err(Error::invalid(
+                    format!("{field}.frequencyHz"),
+                    format!("must be greater than 0 Hz (0 turns shaping off), got {f}"),
+                ));
+            }
+            Ok(Some(f))
+        }
+        (None, Some(fam)) => Err(Error::invalid(
+            format!("{field}.frequencyHz"),
+            format!("the {} shaper needs its frequency", fam.name),
+        )),
+        (None, None) => Ok(None),
+    }
+}
+
 /// Validates the axes; `allowed` are the firmware's axis names.
 fn check(axes: &[AxisShaper], allowed: &[&str], firmware: &str) -> Result<Vec<Axis>> {
     if axes.is_empty() {
@@ -308,45 +332,8 @@ fn check(axes: &[AxisShaper], allowed: &[&str], firmware: &str) -> Result<Vec<Ax
                 format!("axis {name} is given twice"),
             ));
         }
-        let family_name = a.family.to_ascii_lowercase();
-        let family = if family_name == "custom" {
-            None
-        } else {
-            Some(
-                FAMILIES
-                    .iter()
-                    .find(|f| f.name == family_name)
-                    .ok_or_else(|| {
-                        Error::invalid(
-                            format!("{field}.family"),
-                            format!(
-                                "unknown shaper family {:?}; expected {KLIPPER_TYPES}, zvdd, \
-                                 zvddd or custom",
-                                a.family
-                            ),
-                        )
-                    })?,
-            )
-        };
-        let frequency = match a.frequency_hz {
-            Some(f) => {
-                finite(&format!("{field}.frequencyHz"), f)?;
-                if f <= 0.0 {
-                    return Err(Error::invalid(
-                        format!("{field}.frequencyHz"),
-                        format!("must be greater than 0 Hz (0 turns shaping off), got {f}"),
-                    ));
-                }
-                Some(f)
-            }
-            None if family.is_some() => {
-                return Err(Error::invalid(
-                    format!("{field}.frequencyHz"),
-                    format!("the {family_name} shaper needs its frequency"),
-                ))
-            }
-            None => None,
-        };
+        let family = family_of(a, &field)?;
+        let frequency = frequency_of(a, family, &field)?;
         finite(&format!("{field}.damping"), a.damping)?;
         if !(0.0..1.0).contains(&a.damping) {
             return Err(Error::invalid(

@@ -27,9 +27,11 @@
 //!
 //! **2. Best custom shaper.** For firmware that takes an impulse sequence
 //! ([`Firmware::limits`]), a local optimisation of all impulse times and amplitudes
-//! (Nelder–Mead on log-gaps and softmax amplitudes, so the times stay ordered and the
-//! amplitudes positive and summing to 1) started from the best mainline shapers (a
-//! continuation from the best families), on the same robust objective with the same
+//! (Nelder–Mead on log-gaps and softmax amplitudes above the smallest admitted one, so the
+//! times stay ordered and the amplitudes above it and summing to 1) started from the best
+//! mainline shapers (a continuation from the best families), grown one impulse at a time (the
+//! largest split, or a smallest one appended after the last) and finally restarted from its
+//! best point, on the same robust objective with the same
 //! constraints, plus the firmware's limits (impulse count, duration, smallest amplitude) and
 //! Klipper's own score ≤ the best mainline shaper's. The start is feasible and the simplex
 //! keeps its best vertex, so the result is never worse than the best mainline shaper. A second
@@ -38,7 +40,9 @@
 //! a sweep of durations and centroids and polishes the result the same way; it finds somewhat
 //! lower scores at 5–20 times the cost (docs/measured-data.md, *Optimised shapers*), so the
 //! page uses the continuation. Every custom impulse carries at least
-//! [`MIN_CUSTOM_AMPLITUDE`]. The frequency band of the robust score is the modes' frequency
+//! [`MIN_CUSTOM_AMPLITUDE`]. [`no_vibration_bound`] (solver) computes the floor every custom
+//! shaper with no remaining vibration meets on a time grid: on the test set the grid search
+//! reaches it, the continuation comes within a few per cent. The frequency band of the robust score is the modes' frequency
 //! uncertainty (none without modes, [`DEFAULT_FREQUENCY_BAND`]): a ±2 % band halved the gain on
 //! the test set, and without it the shaper designed on one run of a machine scores within 10 %
 //! on the other run (tests/optimal.rs).
@@ -80,7 +84,9 @@ const REFINED_PER_FAMILY: usize = 2;
 const MAX_EVALUATIONS: usize = 700;
 /// Most objective evaluations of the whole custom search (keeps the time per axis bounded:
 /// one evaluation is a few tens of microseconds).
-const CUSTOM_EVALUATION_BUDGET: usize = 2800;
+const CUSTOM_EVALUATION_BUDGET: usize = 4200;
+/// Most restarts of the final polish of the best custom shaper.
+const FINAL_RESTARTS: usize = 3;
 /// Mainline shapers (best first) the continuation starts from.
 const CONTINUATION_STARTS: usize = 2;
 /// Most impulses the custom optimiser uses (beyond this the gain is nil on measured spectra and
@@ -112,46 +118,18 @@ pub enum Firmware {
     Reprapfirmware,
 }
 
-/// What a firmware's custom shaper accepts.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(rename_all = "camelCase")]
-pub struct FirmwareLimits {
-    /// Most impulses.
-    pub max_impulses: usize,
-    /// Longest shaper (last impulse time), s.
-    pub max_duration_s: f64,
-    /// Shortest shaper with more than one impulse, s.
-    pub min_duration_s: f64,
-    /// Smallest amplitude (after normalising to Σ A = 1).
-    pub min_amplitude: f64,
-}
+pub use crate::firmware_limits::FirmwareLimits;
 
 impl Firmware {
     /// The firmware's custom-shaper limits; `None` for mainline Klipper (no custom shaper).
-    ///
-    /// - Kalico: klippy/extras/input_shaper.py `CustomInputShaperParams._parse_custom_shaper`
-    ///   (every |A| ≥ 0.001, Σ A ≥ 0.001, T sorted, 0.001 s ≤ duration ≤ 0.2 s) and
-    ///   klippy/chelper/kin_shaper.c `struct shaper_pulses` (at most 25 pulses). Kalico also
-    ///   takes negative amplitudes; the optimiser here keeps them positive.
-    /// - RepRapFirmware: src/Movement/AxisShaper.h `MaxExtraImpulses = 4` (so 5 impulses) and
-    ///   AxisShaper.cpp `Configure` (`H` read as at most 4 values, `T` as many); amplitudes
-    ///   positive ([`crate::export::to_rrf_m593`] refuses others). RRF states no duration
-    ///   bound; Kalico's 0.2 s is used for it too.
+    /// The numbers and their citations (Kalico's `_parse_custom_shaper` and kin_shaper.c,
+    /// RepRapFirmware's AxisShaper.h) are in [`crate::firmware_limits`], which the config
+    /// writer checks against too.
     pub fn limits(self) -> Option<FirmwareLimits> {
         match self {
             Firmware::Klipper => None,
-            Firmware::Kalico => Some(FirmwareLimits {
-                max_impulses: 25,
-                max_duration_s: 0.2,
-                min_duration_s: 0.001,
-                min_amplitude: 0.001,
-            }),
-            Firmware::Reprapfirmware => Some(FirmwareLimits {
-                max_impulses: 5,
-                max_duration_s: 0.2,
-                min_duration_s: 0.001,
-                min_amplitude: 0.001,
-            }),
+            Firmware::Kalico => Some(crate::firmware_limits::KALICO_CUSTOM),
+            Firmware::Reprapfirmware => Some(crate::firmware_limits::RRF_CUSTOM),
         }
     }
 }
@@ -618,12 +596,16 @@ fn nelder_mead(
     (x, v)
 }
 
-/// Impulses from the custom parameters: n − 1 log-gaps (× `t_ref`), n amplitude logits.
-fn custom_impulses(x: &[f64], n: usize, t_ref: f64) -> Vec<Impulse> {
+/// Impulses from the custom parameters: n − 1 log-gaps (× `t_ref`), n amplitude logits. Each
+/// amplitude is `floor` plus its softmax share of the rest (1 − n·floor), so every parameter
+/// vector gives amplitudes ≥ `floor` summing to 1: the smallest-amplitude rule is built in, and
+/// the optimiser can approach it (where the best shapers sit) without meeting a wall.
+fn custom_impulses(x: &[f64], n: usize, t_ref: f64, floor: f64) -> Vec<Impulse> {
     let logits = &x[n - 1..];
     let m = logits.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let w: Vec<f64> = logits.iter().map(|l| (l - m).exp()).collect();
     let sum: f64 = w.iter().sum();
+    let free = 1.0 - n as f64 * floor;
     let mut t = 0.0;
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
@@ -632,26 +614,28 @@ fn custom_impulses(x: &[f64], n: usize, t_ref: f64) -> Vec<Impulse> {
         }
         out.push(Impulse {
             time: t,
-            amplitude: w[i] / sum,
+            amplitude: floor + free * w[i] / sum,
         });
     }
     out
 }
 
-/// Parameters of `shaper` for [`custom_impulses`] (amplitudes normalised, all > 0).
-fn custom_params(shaper: &Shaper, t_ref: f64) -> Option<Vec<f64>> {
+/// Parameters of `shaper` for [`custom_impulses`] (amplitudes normalised; those at or below
+/// `floor` start just above it); `None` when n·floor ≥ 1.
+fn custom_params(shaper: &Shaper, t_ref: f64, floor: f64) -> Option<Vec<f64>> {
     let imps = shaper.impulses();
     let d = shaper.amplitude_sum();
+    let free = 1.0 - imps.len() as f64 * floor;
+    if free <= 0.0 {
+        return None;
+    }
     let mut x = Vec::with_capacity(2 * imps.len() - 1);
     for w in imps.windows(2) {
         x.push(((w[1].time - w[0].time) / t_ref).ln());
     }
     for imp in imps {
-        let a = imp.amplitude / d;
-        if a <= 0.0 {
-            return None;
-        }
-        x.push(a.ln());
+        let share = (imp.amplitude / d - floor) / free;
+        x.push(share.max(1e-6).ln());
     }
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
@@ -662,23 +646,28 @@ struct Custom {
     eval: Eval,
 }
 
-/// One Nelder–Mead run over all times and amplitudes of a sequence of `start.len()` impulses.
+/// Nelder–Mead over all times and amplitudes of a sequence of `start.len()` impulses, restarted
+/// (at most `restarts` times) from its best point with fresh steps while a restart still lowers
+/// the score by 0.1 % (a collapsed simplex is Nelder–Mead's usual way of stopping short) and the
+/// budget allows.
 fn polish_custom(
     scorer: &Scorer,
     bounds: Bounds,
     limits: FirmwareLimits,
     start: &Shaper,
+    restarts: usize,
 ) -> Result<Option<Custom>> {
     let n = start.len();
     if n < 2 || !admissible(limits, start) {
         return Ok(None);
     }
+    let floor = custom_floor(limits);
     let t_ref = start.duration() / (n - 1) as f64;
-    let Some(x0) = custom_params(start, t_ref) else {
+    let Some(mut x) = custom_params(start, t_ref, floor) else {
         return Ok(None);
     };
     let mut objective = |x: &[f64]| -> f64 {
-        let Ok(s) = Shaper::new(custom_impulses(x, n, t_ref)) else {
+        let Ok(s) = Shaper::new(custom_impulses(x, n, t_ref, floor)) else {
             return f64::INFINITY;
         };
         if s.len() != n || !admissible(limits, &s) {
@@ -689,14 +678,37 @@ fn polish_custom(
             _ => f64::INFINITY,
         }
     };
-    let step = vec![0.1; x0.len()];
-    let (x, v) = nelder_mead(&mut objective, &x0, &step, MAX_EVALUATIONS);
-    if !v.is_finite() {
+    let mut value = f64::INFINITY;
+    for round in 0..=restarts {
+        if round > 0 && scorer.evaluations.get() + MAX_EVALUATIONS / 2 > CUSTOM_EVALUATION_BUDGET {
+            break;
+        }
+        let step = vec![if round == 0 { 0.1 } else { 0.05 }; x.len()];
+        let evals = if round == 0 {
+            MAX_EVALUATIONS
+        } else {
+            MAX_EVALUATIONS / 2
+        };
+        let (xr, vr) = nelder_mead(&mut objective, &x, &step, evals);
+        let gained = vr < 0.999 * value;
+        if vr < value {
+            (x, value) = (xr, vr);
+        }
+        if !gained {
+            break;
+        }
+    }
+    if !value.is_finite() {
         return Ok(None);
     }
-    let shaper = Shaper::new(custom_impulses(&x, n, t_ref))?;
+    let shaper = Shaper::new(custom_impulses(&x, n, t_ref, floor))?;
     let eval = scorer.eval(&shaper, true)?;
     Ok((bounds.admits(&eval) && admissible(limits, &shaper)).then_some(Custom { shaper, eval }))
+}
+
+/// The smallest custom amplitude: the firmware's, at least [`MIN_CUSTOM_AMPLITUDE`].
+fn custom_floor(limits: FirmwareLimits) -> f64 {
+    limits.min_amplitude.max(MIN_CUSTOM_AMPLITUDE)
 }
 
 /// Whether a firmware with `limits` takes `s` (within [`MAX_CUSTOM_IMPULSES`]).
@@ -708,7 +720,7 @@ fn admissible(limits: FirmwareLimits, s: &Shaper) -> bool {
         && (imps.len() == 1 || s.duration() >= limits.min_duration_s)
         && imps
             .iter()
-            .all(|i| i.amplitude / d >= limits.min_amplitude.max(MIN_CUSTOM_AMPLITUDE))
+            .all(|i| i.amplitude / d >= custom_floor(limits) * (1.0 - 1e-9))
 }
 
 /// `s` with its largest impulse split in two (half the amplitude each, a tenth of the mean gap
@@ -746,8 +758,33 @@ fn split_largest(s: &Shaper) -> Result<Shaper> {
     Shaper::new(out)
 }
 
+/// `s` with an impulse of the smallest admitted amplitude appended half a mean gap after the
+/// last (the others scaled to keep Σ A = 1): the start of a run with one impulse more. The
+/// bound of the grid program (`no_vibration_bound`) puts its optimum there on the test set: a
+/// three-impulse core and a smallest impulse at the end.
+fn append_trailing(s: &Shaper, limits: FirmwareLimits) -> Result<Shaper> {
+    let imps = s.impulses();
+    let n = imps.len();
+    let gap = s.duration() / (n.max(2) - 1) as f64;
+    let a = custom_floor(limits) * 1.5;
+    let d = s.amplitude_sum();
+    let mut out: Vec<Impulse> = imps
+        .iter()
+        .map(|i| Impulse {
+            time: i.time,
+            amplitude: i.amplitude / d * (1.0 - a),
+        })
+        .collect();
+    out.push(Impulse {
+        time: s.duration() + 0.5 * gap,
+        amplitude: a,
+    });
+    Shaper::new(out)
+}
+
 /// The best custom shaper: a run from each of the best mainline shapers, then runs with one
-/// impulse more from the best so far while that lowers the score by 0.5 % or more.
+/// impulse more from the best so far (its largest impulse split, or a smallest one appended
+/// after the last) while that lowers the score by 0.5 % or more.
 fn best_custom(
     scorer: &Scorer,
     bounds: Bounds,
@@ -769,14 +806,14 @@ fn best_custom(
     if method != CustomMethod::Grid {
         for start in starts.iter().take(CONTINUATION_STARTS) {
             consider(
-                polish_custom(scorer, bounds, limits, &start.shaper)?,
+                polish_custom(scorer, bounds, limits, &start.shaper, 0)?,
                 &mut best,
             );
         }
     }
     if method != CustomMethod::Continuation {
         for start in grid_starts(scorer, limits, starts)?.iter().take(2) {
-            consider(polish_custom(scorer, bounds, limits, start)?, &mut best);
+            consider(polish_custom(scorer, bounds, limits, start, 0)?, &mut best);
         }
     }
     while let Some(b) = &best {
@@ -785,13 +822,101 @@ fn best_custom(
         {
             break;
         }
-        let grown = split_largest(&b.shaper)?;
-        match polish_custom(scorer, bounds, limits, &grown)? {
+        let mut grown: Option<Custom> = None;
+        for next in [
+            split_largest(&b.shaper)?,
+            append_trailing(&b.shaper, limits)?,
+        ] {
+            if scorer.evaluations.get() + MAX_EVALUATIONS > CUSTOM_EVALUATION_BUDGET {
+                break;
+            }
+            consider(polish_custom(scorer, bounds, limits, &next, 0)?, &mut grown);
+        }
+        match grown {
             Some(c) if c.eval.robust_score() < 0.995 * b.eval.robust_score() => best = Some(c),
             _ => break,
         }
     }
+    if let Some(b) = &best {
+        let again = polish_custom(scorer, bounds, limits, &b.shaper, FINAL_RESTARTS)?;
+        consider(again, &mut best);
+    }
     Ok(best)
+}
+
+/// The grid program's cones of `scorer`: every bin above Klipper's threshold with its bound on
+/// V (threshold / PSD), for every scored case.
+#[cfg(feature = "solver")]
+fn cones_of(scorer: &Scorer) -> grid::Cones {
+    let mut bins = Vec::new();
+    for run in &scorer.runs {
+        let p_max = run.psd.iter().copied().fold(0.0, f64::max);
+        let threshold = p_max / super::recommend::SHAPER_VIBRATION_REDUCTION;
+        bins.extend(
+            run.freq
+                .iter()
+                .zip(&run.psd)
+                .map(|(&f, &p)| (f, threshold / p)),
+        );
+    }
+    grid::Cones {
+        bins,
+        cases: scorer.cases.iter().map(|c| (c.0, c.1)).collect(),
+    }
+}
+
+/// The best Klipper score of any shaper that leaves no remaining vibration (R = 0, by Klipper's
+/// own scoring: its three damping ratios, every bin ≤ 200 Hz of every run under the threshold)
+/// with its impulses on a time grid (`optimal_grid.rs`, `least_smoothing`: 60 intervals of the
+/// duration, duration and centroid swept), positive amplitudes, any number of them, the last
+/// carrying at least `last_min`. With R = 0 Klipper's score is 0.01 × smoothing, so this is
+/// the floor every R = 0 custom shaper meets (up to the grid's resolution); a shaper with
+/// R > 0 pays 0.2 R + R^1.5 against 0.01 and may only beat it by trading a little vibration
+/// for less smoothing.
+#[cfg(feature = "solver")]
+#[derive(Debug, Clone, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct NoVibrationBound {
+    /// 0.01 × `smoothing`.
+    pub score: f64,
+    /// The program's least smoothing, mm.
+    pub smoothing: f64,
+    /// Duration of the best grid, s.
+    pub duration_s: f64,
+    /// Impulses of its solution after merging clusters (not limited to a firmware's count).
+    pub impulses: usize,
+    /// Its smallest merged amplitude.
+    pub smallest_amplitude: f64,
+}
+
+/// [`NoVibrationBound`] of Klipper's calibration `data` (durations swept from ½ to 3 times
+/// Klipper's pick's); `None` when no grid is feasible. Needs the `solver` feature.
+#[cfg(feature = "solver")]
+pub fn no_vibration_bound(
+    data: &CalibrationData,
+    scv: f64,
+    last_min: f64,
+) -> Result<Option<NoVibrationBound>> {
+    finite("scv", scv)?;
+    finite("lastMin", last_min)?;
+    let runs = prepared(data)?;
+    let scorer = Scorer::new(&runs, &[], &[1.0], scv);
+    let pick = klipper_pick(&scorer, data, scv)?;
+    let cones = cones_of(&scorer);
+    Ok(
+        grid::least_smoothing(&cones, pick.shaper.duration(), scv, last_min).map(
+            |(smoothing, duration_s, imps)| NoVibrationBound {
+                score: 0.01 * smoothing,
+                smoothing,
+                duration_s,
+                impulses: imps.len(),
+                smallest_amplitude: imps
+                    .iter()
+                    .map(|i| i.amplitude)
+                    .fold(f64::INFINITY, f64::min),
+            },
+        ),
+    )
 }
 
 /// Starts from the convex grid program around the best mainline shaper's duration.
@@ -804,21 +929,7 @@ fn grid_starts(
     let Some(first) = starts.first() else {
         return Ok(Vec::new());
     };
-    let mut bins = Vec::new();
-    for run in &scorer.runs {
-        let p_max = run.psd.iter().copied().fold(0.0, f64::max);
-        let threshold = p_max / super::recommend::SHAPER_VIBRATION_REDUCTION;
-        bins.extend(
-            run.freq
-                .iter()
-                .zip(&run.psd)
-                .map(|(&f, &p)| (f, threshold / p)),
-        );
-    }
-    let cones = grid::Cones {
-        bins,
-        cases: scorer.cases.iter().map(|c| (c.0, c.1)).collect(),
-    };
+    let cones = cones_of(scorer);
     let max_n = limits.max_impulses.min(MAX_CUSTOM_IMPULSES);
     grid::starts(
         &cones,
@@ -877,28 +988,11 @@ fn own_figures(shaper: &Shaper, data: &CalibrationData, scv: f64) -> Result<Figu
     })
 }
 
-/// Klipper's pick, the best mainline-Klipper shaper and (for a custom-shaper firmware) the best
-/// custom shaper for Klipper's calibration `data` (normalised as Klipper scores it: see
-/// [`CalibrationData::normalize_to_frequencies`]; several runs are pessimised over, as Klipper
-/// does), with the robust score widened by `modes` (may be empty: Klipper's damping set then).
-/// See the module docs.
-///
-/// Errors: a run whose PSD is zero up to 200 Hz, a bad mode (`modes[i]…`),
-/// `uncertaintySigmas` outside [0, 10], Klipper's fit's errors.
-pub fn optimal(
-    data: &CalibrationData,
-    modes: &[MeasuredMode],
-    options: &OptimalOptions,
-) -> Result<OptimalReport> {
-    let runs = prepared(data)?;
-    let k = options.uncertainty_sigmas;
-    if !(0.0..=10.0).contains(&k) {
-        return Err(Error::invalid(
-            "uncertaintySigmas",
-            format!("must lie in [0, 10], got {k}"),
-        ));
-    }
-    finite("scv", options.scv)?;
+/// The robust score's damping ratios (Klipper's three, and ζ − kσ, ζ, ζ + kσ of every mode,
+/// sorted, deduplicated) and frequency factors (for the mainline search: 1 ± kσ_f/f when the
+/// modes carry a frequency uncertainty, else 1 alone; for the custom search: the same band,
+/// at least [`DEFAULT_FREQUENCY_BAND`]). Errors name the bad mode (`modes[i]…`).
+fn robust_sets(modes: &[MeasuredMode], k: f64) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
     count("modes", modes.len(), 0, super::identify::MAX_MODES)?;
     let mut damping: Vec<f64> = KLIPPER_TEST_DAMPING.to_vec();
     let mut rel_f: f64 = 0.0;
@@ -922,7 +1016,83 @@ pub fn optimal(
         vec![1.0]
     };
     let d = rel_f.clamp(DEFAULT_FREQUENCY_BAND, 0.5);
-    let custom_factors = vec![1.0 - d, 1.0, 1.0 + d];
+    Ok((damping, mainline_factors, vec![1.0 - d, 1.0, 1.0 + d]))
+}
+
+/// The best custom shaper within `limits` on `custom_scorer` (the robust score with the
+/// custom frequency band), started from the `mainlines` (best first); the best mainline shaper
+/// when no custom one is admissible.
+fn custom_for(
+    custom_scorer: &Scorer,
+    limits: FirmwareLimits,
+    mainlines: &[Mainline],
+    bounds: Bounds,
+    options: &OptimalOptions,
+) -> Result<Shaper> {
+    let starts: Vec<Mainline> = mainlines
+        .iter()
+        .map(|m| -> Result<Mainline> {
+            Ok(Mainline {
+                eval: custom_scorer.eval(&m.shaper, true)?,
+                ..m.clone()
+            })
+        })
+        .collect::<Result<_>>()?;
+    let main = &mainlines[0];
+    let custom_bounds = Bounds {
+        score: bounds.score.min(main.eval.own_score()),
+        vibrations: bounds.vibrations,
+    };
+    let custom = best_custom(
+        custom_scorer,
+        custom_bounds,
+        limits,
+        &starts,
+        options.custom_method,
+    )?;
+    Ok(custom.map_or_else(|| main.shaper.clone(), |c| c.shaper))
+}
+
+/// The note's sentence on the custom shaper: plainly a small gain below [`SMALL_GAIN`].
+fn custom_note(gain_over_main: f64, improvement: f64) -> String {
+    if gain_over_main < SMALL_GAIN {
+        format!(
+            " The custom shaper buys little: {:.1} % lower score than the best mainline \
+             shaper; the mainline one is as good in practice.",
+            100.0 * gain_over_main
+        )
+    } else {
+        format!(
+            " The custom shaper scores a further {:.1} % lower ({:.1} % below Klipper's pick).",
+            100.0 * gain_over_main,
+            100.0 * improvement
+        )
+    }
+}
+
+/// Klipper's pick, the best mainline-Klipper shaper and (for a custom-shaper firmware) the best
+/// custom shaper for Klipper's calibration `data` (normalised as Klipper scores it: see
+/// [`CalibrationData::normalize_to_frequencies`]; several runs are pessimised over, as Klipper
+/// does), with the robust score widened by `modes` (may be empty: Klipper's damping set then).
+/// See the module docs.
+///
+/// Errors: a run whose PSD is zero up to 200 Hz, a bad mode (`modes[i]…`),
+/// `uncertaintySigmas` outside [0, 10], Klipper's fit's errors.
+pub fn optimal(
+    data: &CalibrationData,
+    modes: &[MeasuredMode],
+    options: &OptimalOptions,
+) -> Result<OptimalReport> {
+    let runs = prepared(data)?;
+    let k = options.uncertainty_sigmas;
+    if !(0.0..=10.0).contains(&k) {
+        return Err(Error::invalid(
+            "uncertaintySigmas",
+            format!("must lie in [0, 10], got {k}"),
+        ));
+    }
+    finite("scv", options.scv)?;
+    let (damping, mainline_factors, custom_factors) = robust_sets(modes, k)?;
 
     let scorer = Scorer::new(&runs, &damping, &mainline_factors, options.scv);
     let pick = klipper_pick(&scorer, data, options.scv)?;
@@ -962,33 +1132,10 @@ pub fn optimal(
     );
     if let Some(limits) = options.firmware.limits() {
         let custom_scorer = Scorer::new(&runs, &damping, &custom_factors, options.scv);
-        let starts: Vec<Mainline> = mainlines
-            .iter()
-            .map(|m| -> Result<Mainline> {
-                Ok(Mainline {
-                    eval: custom_scorer.eval(&m.shaper, true)?,
-                    ..m.clone()
-                })
-            })
-            .collect::<Result<_>>()?;
-        let custom_bounds = Bounds {
-            score: bounds.score.min(main.eval.own_score()),
-            vibrations: bounds.vibrations,
-        };
-        let custom = best_custom(
-            &custom_scorer,
-            custom_bounds,
-            limits,
-            &starts,
-            options.custom_method,
-        )?;
+        let shaper = custom_for(&custom_scorer, limits, &mainlines, bounds, options)?;
         scorer
             .evaluations
             .set(scorer.evaluations.get() + custom_scorer.evaluations.get());
-        let (shaper, _) = match custom {
-            Some(c) => (c.shaper, c.eval),
-            None => (main.shaper.clone(), main.eval),
-        };
         let e = scorer.eval(&shaper, true)?;
         let fig = own_figures(&shaper, data, options.scv)?;
         let gain_over_main = 1.0 - fig.score / rows[1].klipper.score;
@@ -1004,19 +1151,7 @@ pub fn optimal(
             improvement: 1.0 - fig.score / bounds.score,
         });
         recommended = 2;
-        if gain_over_main < SMALL_GAIN {
-            note.push_str(&format!(
-                " The custom shaper buys little: {:.1} % lower score than the best mainline \
-                 shaper; the mainline one is as good in practice.",
-                100.0 * gain_over_main
-            ));
-        } else {
-            note.push_str(&format!(
-                " The custom shaper scores a further {:.1} % lower ({:.1} % below Klipper's pick).",
-                100.0 * gain_over_main,
-                100.0 * rows[2].improvement
-            ));
-        }
+        note.push_str(&custom_note(gain_over_main, rows[2].improvement));
     }
     Ok(OptimalReport {
         rows,
