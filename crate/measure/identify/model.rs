@@ -529,7 +529,7 @@ fn modes_of(
     let m = seeds.len();
     let inflate = problem.input.enbw_bins.max(1.0).sqrt();
     let mut out = Vec::new();
-    for i in 0..m {
+    for (i, seed) in seeds.iter().enumerate() {
         let fi = fit.x[3 * i].exp();
         let z = fit.x[3 * i + 1].exp();
         let (Some(sf), Some(sz)) = (fit.sigma(3 * i), fit.sigma(3 * i + 1)) else {
@@ -546,7 +546,7 @@ fn modes_of(
                 frequency_uncertainty_hz: sf * inflate * fi,
                 damping_uncertainty: sz * inflate * z,
             },
-            peak: seeds[i].peak,
+            peak: seed.peak,
             peak_psd: problem.norm(fi) * problem.level(&fit.x, m, fi),
             standing_db: problem.standing_db(&fit.x, m, i),
         });
