@@ -3,7 +3,16 @@
 //! vibration frequencies … The system identification can also be accomplished in the time
 //! domain").
 //!
-//! 1. **Peaks.** A Welch PSD (Hann, half overlap, segments of 2^⌊log₂(n/8)⌋ samples by default)
+//! 0. **Sweep** (raw recordings, identify/sweep.rs). When the excitation is a linear sweep (as
+//!    Klipper's resonance test drives the toolhead), read from the data itself — the ridge of
+//!    short frames, a robust straight line f(t) — the modes are found and fitted on the whole
+//!    record's periodogram (rectangular window, linear trend removed) inside the swept band
+//!    less √r at each end (r in Hz/s, at least 4 bins; identify/raw.rs): there the periodogram
+//!    is |H|²·|A|² with |A(f)|² ∝ f² smooth, while a Welch average of shorter segments is lumpy
+//!    (each segment sees a few hertz of the sweep) and outside the band there is only noise.
+//!    Steps 1–3 then run on that periodogram (peaks smoothed over about √r/4, the
+//!    rectangular window's kernel in the fit); `spectrum` stays the detection PSD. Otherwise:
+//! 1. **Peaks.** A Welch PSD (Hann, half overlap, segments of 2^⌊log₂(n/4)⌋ samples by default)
 //!    is smoothed in dB over 7 bins; its local maxima with a topographic prominence of at least
 //!    `minProminenceDb` inside the band are the candidate modes, the most prominent first.
 //! 2. **Half-power bandwidth** (frequency domain). On a PSD whose segments are long enough
@@ -41,16 +50,19 @@ mod decay;
 mod half_power;
 mod model;
 mod peaks;
+mod raw;
+mod spectrum;
 mod spectrum_fit;
+mod sweep;
 
-use super::psd::{check_signal, welch, Detrend, Psd, Scaling, WelchOptions, WindowKind};
-use crate::error::{count, finite, positive, Error, Result};
-use decay::{decay_fit, find_decay};
-use half_power::{half_power, smoothed, HalfPower};
+use super::psd::{check_signal, Psd, WindowKind};
+use crate::error::{count, finite, positive, Result};
+use half_power::HalfPower;
 use model::{fit_modes, ModelInput, Seed, WindowSpec};
-use peaks::{detect, Peak};
 use serde::{Deserialize, Serialize};
 use spectrum_fit::spectrum_fit;
+use sweep::detect_sweep;
+pub use sweep::Sweep;
 
 /// One mode on its way out: where its peak is and every estimate made of it.
 struct Slot {
@@ -285,14 +297,9 @@ pub struct Identification {
     pub band_hz: [f64; 2],
     /// The free decay, if one was found and fitted.
     pub free_decay: Option<FreeDecay>,
-}
-
-fn pow2_floor(n: usize) -> usize {
-    if n == 0 {
-        0
-    } else {
-        1usize << (usize::BITS - 1 - n.leading_zeros())
-    }
+    /// The sweep, when the recording is one and its modes were fitted on its whole-record
+    /// periodogram inside the swept band (`spectrum` is then the detection PSD).
+    pub sweep: Option<Sweep>,
 }
 
 /// Identifies the modes in `signal` (see the module docs).
@@ -306,154 +313,38 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
     let fs = positive("sampleRateHz", options.sample_rate_hz)?;
     count("maxModes", options.max_modes, 1, MAX_MODES)?;
     finite("minProminenceDb", options.min_prominence_db)?;
-    let n = signal.len();
-    let n0 = match options.segment_length {
-        Some(s) => {
-            count("segmentLength", s, 64, n)?;
-            s
-        }
-        None => pow2_floor(n / 4).clamp(64, 65536),
-    };
-    let detect_options = WelchOptions {
-        sample_rate_hz: fs,
-        segment_length: Some(n0),
-        overlap: Some(n0 / 2),
-        window: WindowKind::Hann,
-        kaiser_beta: 6.0,
-        symmetric_window: false,
-        detrend: Detrend::Constant,
-        scaling: Scaling::Density,
-    };
-    let psd0 = welch(signal, &detect_options)?;
-    let df0 = psd0.resolution_hz;
-    let f_lo = match options.min_frequency_hz {
-        Some(f) => positive("minFrequencyHz", f)?,
-        None => 3.0 * df0,
-    };
-    let f_hi = match options.max_frequency_hz {
-        Some(f) => positive("maxFrequencyHz", f)?,
-        None => 0.45 * fs,
-    };
-    if f_hi > 0.5 * fs {
-        return Err(Error::invalid(
-            "maxFrequencyHz",
-            format!("must not exceed half the sample rate, {} Hz", 0.5 * fs),
-        ));
-    }
-    if f_lo >= f_hi {
-        return Err(Error::invalid(
-            "minFrequencyHz",
-            format!("must be below maxFrequencyHz ({f_hi} Hz), got {f_lo}"),
-        ));
-    }
-    let bin = |psd: &Psd, f: f64| ((f / psd.resolution_hz).round() as usize).min(psd.psd.len() - 1);
-    let (lo0, hi0) = (bin(&psd0, f_lo).max(1), bin(&psd0, f_hi));
-    let peaks = if hi0 > lo0 + 4 {
-        detect(
-            &psd0,
-            lo0,
-            hi0,
-            options.min_prominence_db,
-            options.max_modes,
-            3,
-        )
-    } else {
-        Vec::new()
-    };
+    let (psd0, n0) = raw::detection_psd(signal, fs, options)?;
+    let band = raw::search_band(options, fs, psd0.resolution_hz)?;
     let mut result = Identification {
         modes: Vec::new(),
         spectrum: psd0.clone(),
         detection_segment_length: n0,
-        band_hz: [f_lo, f_hi],
+        band_hz: band,
         free_decay: None,
+        sweep: None,
     };
-    if peaks.is_empty() {
+    // A sweep (unless the segments are given): its whole-record periodogram inside its band;
+    // otherwise (or when nothing is found there) the Welch path.
+    let sweep = options
+        .segment_length
+        .is_none()
+        .then(|| detect_sweep(signal, fs))
+        .flatten();
+    let mut stage = match sweep {
+        Some(s) => raw::sweep_stage(signal, fs, s, band, options)?,
+        None => None,
+    };
+    if stage.is_some() {
+        result.sweep = sweep;
+    } else {
+        stage = raw::welch_stage(signal, psd0, n0, band, options)?;
+    }
+    let Some(stage) = stage else {
         return Ok(result);
-    }
-    // Segments from the record and the peaks: the narrowest half-power width should span 4 to
-    // 12 bins (the fit models the window's smearing, so a few bins suffice, and shorter
-    // segments average more of them: a sweep's PSD is then steadier). Longer while it spans
-    // fewer (up to n/4), or once shorter when it spans more (down to 64 samples).
-    let n_max = pow2_floor(n / 4).max(n0).min(1 << 20);
-    let mut psd = psd0;
-    let mut widths: Vec<Option<HalfPower>>;
-    let mut seg = n0;
-    let mut shrunk = false;
-    loop {
-        let (lo, hi) = (bin(&psd, f_lo).max(1), bin(&psd, f_hi));
-        widths = peaks
-            .iter()
-            .map(|p| {
-                let search = (4.0 * df0).max(0.02 * p.frequency_hz);
-                // On the spectrum averaged over a tenth of the peak's width, so that the bins'
-                // noise does not move the crossings: from a heavy average down to that.
-                let mut h = ((hi - lo) / 100).clamp(3, 2000);
-                let mut found = None;
-                for _ in 0..10 {
-                    let Some(hp) = half_power(
-                        &smoothed(&psd, h),
-                        p.frequency_hz,
-                        search,
-                        lo,
-                        hi,
-                        options.signal,
-                    ) else {
-                        break;
-                    };
-                    found = Some(hp);
-                    let next = ((hp.width_hz / psd.resolution_hz) / 10.0).floor() as usize;
-                    if next + 1 >= h && next <= h + 1 {
-                        break;
-                    }
-                    h = next.min(2000);
-                }
-                found
-            })
-            .collect();
-        let narrowest = widths
-            .iter()
-            .flatten()
-            .map(|h| h.width_hz / psd.resolution_hz)
-            .fold(f64::INFINITY, f64::min);
-        if !narrowest.is_finite() {
-            break;
-        }
-        if narrowest > 12.0 && !shrunk && seg > 64 {
-            shrunk = true;
-            let factor = pow2_floor((narrowest / 6.0).floor() as usize).max(1);
-            seg = (seg / factor).max(64);
-        } else if narrowest < 4.0 && !shrunk && seg < n_max {
-            let factor = (8.0 / narrowest).ceil() as usize;
-            seg = (seg * factor.next_power_of_two()).min(n_max);
-        } else {
-            break;
-        }
-        psd = welch(
-            signal,
-            &WelchOptions {
-                segment_length: Some(seg),
-                overlap: Some(seg / 2),
-                ..detect_options.clone()
-            },
-        )?;
-    }
-    let (lo, hi) = (bin(&psd, f_lo).max(1), bin(&psd, f_hi));
-    let found: Vec<(Peak, HalfPower)> = peaks
-        .iter()
-        .zip(&widths)
-        .filter_map(|(p, h)| h.map(|h| (*p, h)))
-        .collect();
-    // Peaks that collapse onto the same maximum are one mode.
-    let mut found_unique: Vec<(Peak, HalfPower)> = Vec::new();
-    for item in found {
-        if !found_unique.iter().any(|(_, h)| {
-            (h.peak_hz - item.1.peak_hz).abs() < 0.5 * h.width_hz.min(item.1.width_hz)
-        }) {
-            found_unique.push(item);
-        }
-    }
-    let halves: Vec<HalfPower> = found_unique.iter().map(|(_, h)| *h).collect();
-    let mut slots: Vec<Slot> = found_unique
+    };
+    let raw::Stage { psd, found, band } = stage;
+    let halves: Vec<HalfPower> = found.iter().map(|(_, h)| *h).collect();
+    let mut slots: Vec<Slot> = found
         .iter()
         .map(|(p, h)| Slot {
             peak_hz: h.peak_hz,
@@ -468,7 +359,11 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         resolution_hz: psd.resolution_hz,
         even: true,
         window: Some(WindowSpec {
-            kind: WindowKind::Hann,
+            kind: if result.sweep.is_some() {
+                WindowKind::Rectangular
+            } else {
+                WindowKind::Hann
+            },
             length: psd.segment_length,
             symmetric: false,
             beta: 6.0,
@@ -476,63 +371,28 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         klipper_normalized: false,
         kind: options.signal,
         enbw_bins: psd.enbw_bins,
-        band: [f_lo, f_hi],
+        band,
     };
     let joint = joint_fit(&input, &halves, options.max_modes, &mut slots);
     if !joint && !halves.is_empty() {
+        let bin = |f: f64| ((f / psd.resolution_hz).round() as usize).min(psd.psd.len() - 1);
+        let (lo, hi) = (bin(band[0]).max(1), bin(band[1]));
         if let Some(fits) = spectrum_fit(&psd, &halves, lo, hi, options.signal) {
             for (slot, f) in slots.iter_mut().zip(fits) {
                 slot.push_fit(f);
             }
         }
     }
-    let mut estimates: Vec<Vec<Estimate>> = slots.iter().map(|s| s.estimates.clone()).collect();
     if options.free_decay && !slots.is_empty() {
-        let lowest = slots
-            .iter()
-            .map(|s| s.estimates[0].frequency_hz)
-            .fold(f64::INFINITY, f64::min);
-        if let Some((start, end, level_db)) = find_decay(signal, fs, lowest) {
-            let initial: Vec<(f64, f64)> = estimates
-                .iter()
-                .map(|e| {
-                    let best = e.last().copied().unwrap_or(e[0]);
-                    (best.frequency_hz, best.damping)
-                })
-                .collect();
-            let f_max = initial.iter().map(|p| p.0).fold(0.0, f64::max);
-            let mut stride = 1;
-            while (end - start) / stride > 40_000 && fs / (stride as f64 * 2.0) > 3.0 * f_max {
-                stride *= 2;
-            }
-            let y: Vec<f64> = signal[start..end].iter().step_by(stride).copied().collect();
-            let end = start + y.len() * stride;
-            if let Some(decays) = decay_fit(&y, fs / stride as f64, &initial) {
-                result.free_decay = Some(FreeDecay {
-                    start_s: start as f64 / fs,
-                    end_s: end as f64 / fs,
-                    level_db,
-                });
-                for (e, d) in estimates.iter_mut().zip(decays) {
-                    let f0 = e[0].frequency_hz;
-                    let agrees = (d.frequency_hz - f0).abs() < 0.2 * f0
-                        && d.damping > 0.0
-                        && d.damping_uncertainty.is_finite();
-                    if agrees {
-                        e.push(d);
-                    }
-                }
-            }
-        }
-    }
-    for (slot, e) in slots.iter_mut().zip(estimates) {
-        slot.estimates = e;
+        result.free_decay = raw::free_decay_stage(signal, fs, &mut slots);
     }
     result.modes = slots.into_iter().map(Slot::into_mode).collect();
     crate::sort::sort_by(&mut result.modes, |a, b| {
         a.frequency_hz.total_cmp(&b.frequency_hz)
     });
-    result.spectrum = psd;
+    if result.sweep.is_none() {
+        result.spectrum = psd;
+    }
     Ok(result)
 }
 
@@ -550,155 +410,35 @@ pub fn identify_spectrum(
     spectrum: &super::spectrum_file::SpectrumFile,
     options: &IdentifyOptions,
 ) -> Result<Identification> {
-    use super::spectrum_file::{resolution, Normalization};
     count("maxModes", options.max_modes, 1, MAX_MODES)?;
     finite("minProminenceDb", options.min_prominence_db)?;
-    let f = &spectrum.frequency_hz;
-    let p = &spectrum.psd;
-    count(
-        "spectrum.frequencyHz",
-        f.len(),
-        8,
-        super::psd::MAX_SEGMENT_LENGTH,
-    )?;
-    if p.len() != f.len() {
-        return Err(Error::invalid(
-            "spectrum.psd",
-            format!("has {} values for {} frequencies", p.len(), f.len()),
-        ));
-    }
-    if let Some(i) = p.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
-        return Err(Error::invalid(
-            format!("spectrum.psd[{i}]"),
-            format!("must be a finite number ≥ 0, got {}", p[i]),
-        ));
-    }
-    if let Some(i) = f.windows(2).position(|w| w[1] <= w[0] || w[1].is_nan()) {
-        return Err(Error::invalid(
-            format!("spectrum.frequencyHz[{}]", i + 1),
-            "frequencies must increase",
-        ));
-    }
-    let (df, even) = resolution(f);
-    if !even {
-        return Err(Error::invalid(
-            "spectrum.frequencyHz",
-            "the bins are not evenly spaced",
-        ));
-    }
-    // The grid from 0: f_k = k·Δf (Klipper's rows start at bin 0; a file starting later gets
-    // empty bins in front).
-    let k0 = (f[0] / df).round().max(0.0) as usize;
-    let n = k0 + f.len();
-    let grid: Vec<f64> = (0..n).map(|k| k as f64 * df).collect();
-    let mut psd_full = vec![0.0; k0];
-    psd_full.extend_from_slice(p);
-    let normalized = spectrum.normalization == Normalization::Klipper;
-    let segment = spectrum
-        .segment_length
-        .unwrap_or_else(|| (2 * (n - 1)).next_power_of_two().max(256));
-    let kaiser = WindowSpec {
-        kind: WindowKind::Kaiser,
-        length: segment,
-        symmetric: true,
-        beta: 6.0,
-    };
-    let w = super::psd::window(WindowKind::Kaiser, 2048, true, 6.0);
-    let (s1, s2) = w.iter().fold((0.0, 0.0), |(a, b), v| (a + v, b + v * v));
-    let enbw = 2048.0 * s2 / (s1 * s1);
-    let psd = Psd {
-        frequency_hz: grid,
-        psd: psd_full,
-        segment_length: segment,
-        overlap: segment / 2,
-        segments: 0,
-        resolution_hz: df,
-        enbw_bins: enbw,
-        sample_rate_hz: df * segment as f64,
-    };
-    let lowest: f64 = if normalized { 10.0 } else { 5.0 };
-    let f_lo = match options.min_frequency_hz {
-        Some(v) => positive("minFrequencyHz", v)?,
-        None => lowest.max(2.0 * df),
-    };
-    let f_hi = match options.max_frequency_hz {
-        Some(v) => positive("maxFrequencyHz", v)?,
-        None => (n - 1) as f64 * df,
-    };
-    if f_lo >= f_hi {
-        return Err(Error::invalid(
-            "minFrequencyHz",
-            format!("must be below maxFrequencyHz ({f_hi} Hz), got {f_lo}"),
-        ));
-    }
+    let grid = spectrum::grid(spectrum)?;
+    let [f_lo, f_hi] = spectrum::band(&grid, options)?;
+    let psd = &grid.psd;
+    let (df, n) = (psd.resolution_hz, psd.psd.len());
     let lo = ((f_lo / df).ceil() as usize).clamp(1, n - 1);
     let hi = ((f_hi / df).floor() as usize).min(n - 1);
     let mut result = Identification {
         modes: Vec::new(),
         spectrum: psd.clone(),
-        detection_segment_length: segment,
+        detection_segment_length: psd.segment_length,
         band_hz: [f_lo, f_hi],
         free_decay: None,
+        sweep: None,
     };
     if hi < lo + 4 {
         return Ok(result);
     }
-    // Peaks of the spectrum with Klipper's normalisation undone (the modal peaks are those of
-    // the un-normalised PSD).
-    let unnormalized = Psd {
-        psd: psd
-            .psd
-            .iter()
-            .zip(&psd.frequency_hz)
-            .map(|(v, f)| if normalized { v * (f + 0.1) } else { *v })
-            .collect(),
-        ..psd.clone()
-    };
-    let peaks = detect(
-        &unnormalized,
-        lo,
-        hi,
-        options.min_prominence_db,
-        options.max_modes,
-        1,
-    );
-    let mut slots = Vec::new();
-    let mut halves = Vec::new();
-    for pk in &peaks {
-        let search = 2.0 * df;
-        if let Some(h) = half_power(
-            &unnormalized,
-            pk.frequency_hz,
-            search,
-            lo,
-            hi,
-            options.signal,
-        ) {
-            if !halves
-                .iter()
-                .any(|o: &HalfPower| (o.peak_hz - h.peak_hz).abs() < df)
-            {
-                // Leakage widens a narrow peak to the kernel's width: the seed's damping is an
-                // upper bound, kept as it is.
-                halves.push(h);
-                slots.push(Slot {
-                    peak_hz: h.peak_hz,
-                    peak_psd: h.peak_psd,
-                    prominence_db: pk.prominence_db,
-                    estimates: vec![h.estimate],
-                });
-            }
-        }
-    }
+    let (halves, mut slots) = spectrum::seeds(&grid, lo, hi, options);
     let input = ModelInput {
         frequency_hz: &psd.frequency_hz,
         psd: &psd.psd,
         resolution_hz: df,
         even: true,
-        window: Some(kaiser),
-        klipper_normalized: normalized,
+        window: Some(grid.window),
+        klipper_normalized: grid.normalized,
         kind: options.signal,
-        enbw_bins: enbw,
+        enbw_bins: psd.enbw_bins,
         band: [f_lo, f_hi],
     };
     joint_fit(&input, &halves, options.max_modes, &mut slots);

@@ -108,19 +108,8 @@ fn kernel(spec: WindowSpec, q: usize) -> Vec<f64> {
 }
 
 /// The model without kernel and normalisation at frequency f: E(f)|c + ΣgH|².
-fn response(x: &[f64], m: usize, power: i32, f_ref: f64, edges: Edges, f: f64) -> f64 {
+fn response(x: &[f64], m: usize, power: i32, f_ref: f64, f: f64) -> f64 {
     let f = f.abs().max(1e-9);
-    let mut band = 1.0;
-    if edges.any() {
-        let w = x[x.len() - 1].exp();
-        let logistic = |t: f64| 1.0 / (1.0 + (-t).exp());
-        if edges.low {
-            band *= logistic((f - x[3 * m + 3]) / w);
-        }
-        if edges.high {
-            band *= logistic((x[3 * m + 3 + usize::from(edges.low)] - f) / w);
-        }
-    }
     let mut h = Complex::new(x[3 * m], 0.0);
     for i in 0..m {
         let fi = x[3 * i].exp();
@@ -130,25 +119,7 @@ fn response(x: &[f64], m: usize, power: i32, f_ref: f64, edges: Edges, f: f64) -
         let num = g * (f / fi).powi(power) * fi * fi / den.norm_sqr();
         h += den.conj() * num;
     }
-    band * (x[3 * m + 1] * (f / f_ref).ln()).exp() * h.norm_sqr()
-}
-
-/// The swept band's edges inside the fitted range, when the PSD shows them (a narrow sweep):
-/// E(f) is then multiplied by logistic steps at f_lo and f_hi of a common width w, all three
-/// fitted (parameters after ln B: f_lo, f_hi, ln w, those present).
-#[derive(Debug, Clone, Copy, Default)]
-struct Edges {
-    low: bool,
-    high: bool,
-}
-
-impl Edges {
-    fn any(self) -> bool {
-        self.low || self.high
-    }
-    fn count(self) -> usize {
-        usize::from(self.low) + usize::from(self.high) + usize::from(self.any())
-    }
+    (x[3 * m + 1] * (f / f_ref).ln()).exp() * h.norm_sqr()
 }
 
 struct Problem<'a> {
@@ -157,21 +128,27 @@ struct Problem<'a> {
     logs: Vec<f64>,
     f_ref: f64,
     power: i32,
-    edges: Edges,
 }
 
 impl Problem<'_> {
+    /// The window's kernel at q fine steps per bin (none for an uneven grid or no window).
+    fn kernel(&self, q: usize) -> Vec<f64> {
+        match self.input.window {
+            Some(w) if self.input.even => kernel(w, q),
+            _ => Vec::new(),
+        }
+    }
+
     /// Model values at the problem's bins for parameters x with m modes.
     fn eval(&self, x: &[f64], m: usize, q: usize, kern: &[f64], out: &mut Vec<f64>) -> bool {
         out.clear();
         let inp = self.input;
         let floor = x[3 * m + 2].exp();
+        let at = |f: f64| response(x, m, self.power, self.f_ref, f);
         if kern.is_empty() {
             for &k in &self.bins {
                 let f = inp.frequency_hz[k];
-                out.push(
-                    self.norm(f) * (response(x, m, self.power, self.f_ref, self.edges, f) + floor),
-                );
+                out.push(self.norm(f) * (at(f) + floor));
             }
         } else {
             // The kernel where a mode is within reach of it (5 half-power widths and the
@@ -194,13 +171,10 @@ impl Problem<'_> {
                 let value = if near {
                     kern.iter()
                         .enumerate()
-                        .map(|(jj, c)| {
-                            let nu = f + (jj as f64 - j_max as f64) * df / q as f64;
-                            c * response(x, m, self.power, self.f_ref, self.edges, nu)
-                        })
+                        .map(|(jj, c)| c * at(f + (jj as f64 - j_max as f64) * df / q as f64))
                         .sum()
                 } else {
-                    response(x, m, self.power, self.f_ref, self.edges, f)
+                    at(f)
                 };
                 out.push(self.norm(f) * (value + floor));
             }
@@ -216,22 +190,37 @@ impl Problem<'_> {
         }
     }
 
+    /// Finite-difference steps of Levenberg–Marquardt for the parameters of `x`.
+    fn steps(x: &[f64], m: usize) -> Vec<f64> {
+        let scale = (0..m).map(|i| x[3 * i + 2].abs()).fold(1e-300, f64::max);
+        (0..3 * m + 3)
+            .map(|i| {
+                if i < 3 * m {
+                    match i % 3 {
+                        0 => 1e-7,
+                        1 => 1e-5,
+                        _ => 1e-6 * x[i].abs().max(1e-3 * scale),
+                    }
+                } else if i == 3 * m {
+                    1e-6 * scale
+                } else {
+                    1e-5
+                }
+            })
+            .collect()
+    }
+
+    /// Fits from x0, refining the kernel's fine steps q (up to 3 times) as the dampings move.
     fn fit(&self, x0: &[f64], m: usize) -> Option<(FitResult, usize)> {
         let mut q = self.q_for(x0, m);
         let mut start = x0.to_vec();
         let mut result = None;
         for _ in 0..3 {
-            let kern = match self.input.window {
-                Some(w) if self.input.even => kernel(w, q),
-                _ => Vec::new(),
-            };
+            let kern = self.kernel(q);
             let mut buf = Vec::new();
             let residual = |x: &[f64], out: &mut Vec<f64>| -> bool {
-                for i in 0..m {
-                    let z = x[3 * i + 1];
-                    if !(z < 0.0 && z > -12.0) {
-                        return false;
-                    }
+                if (0..m).any(|i| !(x[3 * i + 1] < 0.0 && x[3 * i + 1] > -12.0)) {
+                    return false;
                 }
                 if !self.eval(x, m, q, &kern, &mut buf) {
                     return false;
@@ -240,27 +229,7 @@ impl Problem<'_> {
                 out.extend(self.logs.iter().zip(&buf).map(|(l, s)| l - s.ln()));
                 true
             };
-            let scale = (0..m)
-                .map(|i| start[3 * i + 2].abs())
-                .fold(1e-300, f64::max);
-            let steps: Vec<f64> = (0..3 * m + 3 + self.edges.count())
-                .map(|i| {
-                    if i >= 3 * m + 3 {
-                        1e-6 * start[i].abs().max(1e-3)
-                    } else if i < 3 * m {
-                        match i % 3 {
-                            0 => 1e-7,
-                            1 => 1e-5,
-                            _ => 1e-6 * start[i].abs().max(1e-3 * scale),
-                        }
-                    } else if i == 3 * m {
-                        1e-6 * scale
-                    } else {
-                        1e-5
-                    }
-                })
-                .collect();
-            let fit = levenberg_marquardt(residual, &start, &steps, 60)?;
+            let fit = levenberg_marquardt(residual, &start, &Self::steps(&start, m), 60)?;
             let q_new = self.q_for(&fit.x, m);
             let done = q_new <= q;
             start = fit.x.clone();
@@ -281,6 +250,19 @@ impl Problem<'_> {
             .fold(f64::INFINITY, f64::min);
         ((6.0 * df / narrowest).ceil() as usize).clamp(4, 32)
     }
+
+    /// The model's level at f (no kernel, no normalisation) with the floor.
+    fn level(&self, x: &[f64], m: usize, f: f64) -> f64 {
+        response(x, m, self.power, self.f_ref, f) + x[3 * m + 2].exp()
+    }
+
+    /// How far mode i stands over the model without it, at its frequency, dB.
+    fn standing_db(&self, x: &[f64], m: usize, i: usize) -> f64 {
+        let fi = x[3 * i].exp();
+        let mut without = x.to_vec();
+        without[3 * i + 2] = 0.0;
+        10.0 * (self.level(x, m, fi) / self.level(&without, m, fi).max(1e-300)).log10()
+    }
 }
 
 fn bic(fit: &FitResult, n_eff: f64) -> f64 {
@@ -289,14 +271,7 @@ fn bic(fit: &FitResult, n_eff: f64) -> f64 {
 }
 
 /// Initial parameters from seeds, with gain signs from `signs` (bit i−1 flips mode i).
-fn start(
-    seeds: &[Seed],
-    signs: usize,
-    floor: f64,
-    direct: f64,
-    exponent: f64,
-    edges: &[f64],
-) -> Vec<f64> {
+fn start(seeds: &[Seed], signs: usize, floor: f64, direct: f64, exponent: f64) -> Vec<f64> {
     let mut x = Vec::with_capacity(3 * seeds.len() + 3);
     for (i, s) in seeds.iter().enumerate() {
         let sign = if i > 0 && (signs >> (i - 1)) & 1 == 1 {
@@ -312,47 +287,33 @@ fn start(
     x.push(direct); // c
     x.push(exponent); // a
     x.push(floor.max(1e-300).ln());
-    x.extend_from_slice(edges);
     x
 }
 
-/// Fits the modes from `seeds` jointly, then adds modes found in the residuals while the
-/// information criterion says so (up to `max_modes`). None when no fit converged.
-pub(crate) fn fit_modes(
+/// The fitted range: around every seed, ±max(8ζ, 60–80 %), inside the band.
+fn fit_range(input: &ModelInput, seeds: &[Seed]) -> (f64, f64) {
+    let lo = seeds
+        .iter()
+        .map(|s| s.frequency_hz * (1.0 - (8.0 * s.damping).clamp(0.6, 0.8)))
+        .fold(f64::INFINITY, f64::min);
+    let hi = seeds
+        .iter()
+        .map(|s| s.frequency_hz * (1.0 + (8.0 * s.damping).max(0.8)))
+        .fold(0.0, f64::max);
+    (lo.max(input.band[0]), hi.min(input.band[1]))
+}
+
+/// A narrow sweep's band edges in bins `k_lo..k_hi`: going out from the outermost seeds, a
+/// fall of more than 12 dB from one bin to the next that does not come back (a mode's flank,
+/// smoothed by the window, is gentler). Returns (low edge, high edge), Hz.
+fn band_edges(
     input: &ModelInput,
     seeds: &[Seed],
-    max_modes: usize,
-) -> Option<Vec<FittedMode>> {
-    if seeds.is_empty() {
-        return None;
-    }
-    let df = input.resolution_hz;
+    k_lo: usize,
+    k_hi: usize,
+) -> (Option<f64>, Option<f64>) {
     let f = input.frequency_hz;
-    // The fitted range: around every seed, ±max(8ζ, 35 %), inside the band.
-    let range = |seeds: &[Seed]| -> (f64, f64) {
-        let lo = seeds
-            .iter()
-            .map(|s| s.frequency_hz * (1.0 - (8.0 * s.damping).clamp(0.6, 0.8)))
-            .fold(f64::INFINITY, f64::min);
-        let hi = seeds
-            .iter()
-            .map(|s| s.frequency_hz * (1.0 + (8.0 * s.damping).max(0.8)))
-            .fold(0.0, f64::max);
-        (lo.max(input.band[0]), hi.min(input.band[1]))
-    };
-    let (lo, hi) = range(seeds);
-    let bins: Vec<usize> = (0..f.len())
-        .filter(|&k| f[k] >= lo && f[k] <= hi && input.psd[k] > 0.0 && input.psd[k].is_finite())
-        .filter(|&k| {
-            !input.klipper_normalized || f[k] >= super::super::spectrum_file::KLIPPER_MIN_FREQ_HZ
-        })
-        .collect();
-    if bins.len() < 3 * seeds.len() + 6 {
-        return None;
-    }
-    // With the kernel the bins must be contiguous (the fine grid spans them).
-    // Band edges: going out from the outermost seeds, a fall of more than 12 dB from one bin
-    // to the next that does not come back (a mode's flank, smoothed by the window, is gentler).
+    let df = input.resolution_hz;
     let unnorm = |k: usize| {
         input.psd[k]
             * if input.klipper_normalized {
@@ -362,28 +323,38 @@ pub(crate) fn fit_modes(
             }
     };
     let drop = |a: usize, b: usize| 10.0 * (unnorm(b).max(1e-300) / unnorm(a).max(1e-300)).log10();
-    let (k_lo, k_hi) = (bins[0], bins[bins.len() - 1]);
     let seed_lo = seeds
         .iter()
         .map(|s| s.frequency_hz)
         .fold(f64::INFINITY, f64::min);
     let seed_hi = seeds.iter().map(|s| s.frequency_hz).fold(0.0, f64::max);
-    let mut edge_hi = None;
-    for k in k_lo + 1..k_hi {
-        if f[k - 1] > seed_hi && drop(k - 1, k) < -12.0 && drop(k, k + 1) < 3.0 {
-            edge_hi = Some(f[k - 1] + 0.5 * df);
-            break;
-        }
+    let edge_hi = (k_lo + 1..k_hi)
+        .find(|&k| f[k - 1] > seed_hi && drop(k - 1, k) < -12.0 && drop(k, k + 1) < 3.0)
+        .map(|k| f[k - 1] + 0.5 * df);
+    let edge_lo = (k_lo + 1..k_hi)
+        .rev()
+        .find(|&k| f[k + 1] < seed_lo && drop(k + 1, k) < -12.0 && drop(k, k - 1) < 3.0)
+        .map(|k| f[k + 1] - 0.5 * df);
+    (edge_lo, edge_hi)
+}
+
+/// The bins fitted: in [lo, hi] with a positive PSD (above Klipper's lowest frequency when
+/// normalised); every bin within 3 half-power widths (at most 30 bins) and 6 bins of a seed,
+/// the others thinned to about 1500; and, inside a narrow sweep's band edges (where the
+/// excitation is smooth; the window smears an edge over ±2 bins), 2.5 bins inside them.
+fn fit_bins(input: &ModelInput, seeds: &[Seed], lo: f64, hi: f64) -> Option<Vec<usize>> {
+    let f = input.frequency_hz;
+    let df = input.resolution_hz;
+    let bins: Vec<usize> = (0..f.len())
+        .filter(|&k| f[k] >= lo && f[k] <= hi && input.psd[k] > 0.0 && input.psd[k].is_finite())
+        .filter(|&k| {
+            !input.klipper_normalized || f[k] >= super::super::spectrum_file::KLIPPER_MIN_FREQ_HZ
+        })
+        .collect();
+    if bins.len() < 3 * seeds.len() + 6 {
+        return None;
     }
-    let mut edge_lo = None;
-    for k in (k_lo + 1..k_hi).rev() {
-        if f[k + 1] < seed_lo && drop(k + 1, k) < -12.0 && drop(k, k - 1) < 3.0 {
-            edge_lo = Some(f[k + 1] - 0.5 * df);
-            break;
-        }
-    }
-    // Every bin within 3 half-power widths (at most 30 bins) and 6 bins of a seed; the others
-    // thinned to about 1500.
+    let (edge_lo, edge_hi) = band_edges(input, seeds, bins[0], bins[bins.len() - 1]);
     let near_seed = |k: usize| {
         seeds.iter().any(|s| {
             (f[k] - s.frequency_hz).abs()
@@ -402,34 +373,111 @@ pub(crate) fn fit_modes(
             far_seen += 1;
             (far_seen - 1) % stride == 0
         })
-        .collect();
-    // Inside a swept band's edges the excitation is smooth; at them it is not (and the
-    // window smears them over ±2 bins): the fit keeps to the bins 2.5 bins inside.
-    let bins: Vec<usize> = bins
-        .into_iter()
         .filter(|&k| {
             edge_lo.is_none_or(|e| f[k] >= e + 2.0 * df)
                 && edge_hi.is_none_or(|e| f[k] <= e - 2.0 * df)
         })
         .collect();
-    if bins.len() < 3 * seeds.len() + 6 {
+    (bins.len() >= 3 * seeds.len() + 6).then_some(bins)
+}
+
+/// The joint fit of given seeds from every start, the least residual kept. Starts: white
+/// (a = 0) or swept (a = 2: Klipper's acceleration ∝ f at constant Hz/s) excitation; the
+/// direct term of either sign (its level `direct` from the low end of the range under that
+/// excitation) or none; every sign pattern of the gains (up to 4 modes).
+fn best_fit(
+    problem: &Problem,
+    seeds: &[Seed],
+    floor: f64,
+    direct: f64,
+) -> Option<(FitResult, usize)> {
+    let f = problem.input.frequency_hz;
+    let m = seeds.len();
+    let patterns = if m <= 4 { 1usize << (m - 1) } else { 1 };
+    let mut best: Option<(FitResult, usize)> = None;
+    for signs in 0..patterns {
+        for a in [0.0, 2.0] {
+            let c0 = direct / (f[problem.bins[0]] / problem.f_ref).powf(0.5 * a);
+            for c in [c0, -c0, 0.0] {
+                let x0 = start(seeds, signs, floor, c, a);
+                if let Some(r) = problem.fit(&x0, m) {
+                    if best.as_ref().is_none_or(|b| r.0.rss < b.0.rss) {
+                        best = Some(r);
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
+/// The largest positive residual (smoothed over 3 bins) away from the fitted modes, ≥ 0.3 in
+/// log: the seed of one more mode.
+fn residual_seed(problem: &Problem, x: &[f64], m: usize, q: usize) -> Option<Seed> {
+    let f = problem.input.frequency_hz;
+    let df = problem.input.resolution_hz;
+    let mut model = Vec::new();
+    if !problem.eval(x, m, q, &problem.kernel(q), &mut model) {
         return None;
     }
-    let (edge_lo, edge_hi): (Option<f64>, Option<f64>) = (None, None);
-    let edges = Edges {
-        low: edge_lo.is_some(),
-        high: edge_hi.is_some(),
+    let res: Vec<f64> = problem
+        .logs
+        .iter()
+        .zip(&model)
+        .map(|(l, s)| l - s.ln())
+        .collect();
+    let n = res.len();
+    let sm: Vec<f64> = (0..n)
+        .map(|i| {
+            let a = i.saturating_sub(1);
+            let b = (i + 1).min(n - 1);
+            res[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
+        })
+        .collect();
+    let away = |fk: f64| {
+        (0..m).all(|i| {
+            let fi = x[3 * i].exp();
+            let w = (2.0 * x[3 * i + 1].exp() * fi).max(1.5 * df);
+            (fk - fi).abs() > w
+        })
     };
-    let mut edge_start: Vec<f64> = edge_lo.into_iter().chain(edge_hi).collect();
-    if edges.any() {
-        edge_start.push((0.5 * df).ln());
+    let (i_max, &r_max) = sm
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| away(f[problem.bins[*i]]))
+        .max_by(|a, b| a.1.total_cmp(b.1))?;
+    if r_max < 0.3 {
+        return None;
     }
+    let fk = f[problem.bins[i_max]];
+    Some(Seed {
+        frequency_hz: fk,
+        damping: (1.5 * df / fk).max(0.02),
+        peak_psd: problem.input.psd[problem.bins[i_max]] / problem.norm(fk),
+        peak: None,
+    })
+}
+
+/// Fits the modes from `seeds` jointly, then adds modes found in the residuals while the
+/// information criterion says so (up to `max_modes`): a candidate is kept when the BIC (bins
+/// counted as n/ENBW) falls by more than 10 and it stands ≥ 3 dB over the model without it.
+/// None when no fit converged.
+pub(crate) fn fit_modes(
+    input: &ModelInput,
+    seeds: &[Seed],
+    max_modes: usize,
+) -> Option<Vec<FittedMode>> {
+    if seeds.is_empty() {
+        return None;
+    }
+    let f = input.frequency_hz;
+    let (lo, hi) = fit_range(input, seeds);
+    let bins = fit_bins(input, seeds, lo, hi)?;
     let problem = Problem {
         input,
         logs: bins.iter().map(|&k| input.psd[k].ln()).collect(),
         f_ref: (lo * hi).sqrt(),
         power: input.kind.power(),
-        edges,
         bins,
     };
     let floor = {
@@ -443,141 +491,53 @@ pub(crate) fn fit_modes(
     };
     let n_eff = problem.bins.len() as f64 / input.enbw_bins.max(1.0);
     // The direct term's start: the level at the low end of the range (where a mode's
-    // acceleration response has fallen off), either sign, or none.
+    // acceleration response has fallen off).
     let direct = {
         let k = problem.bins[0];
         (input.psd[k] / problem.norm(f[k])).sqrt()
     };
-    let run = |seeds: &[Seed]| -> Option<(FitResult, usize)> {
-        let m = seeds.len();
-        let patterns = if m <= 4 { 1usize << (m - 1) } else { 1 };
-        let mut best: Option<(FitResult, usize)> = None;
-        // Starts: white (a = 0) or swept (a = 2: Klipper's acceleration ∝ f at constant Hz/s)
-        // excitation; the direct term of either sign (its level from the low end of the range
-        // under that excitation) or none; every sign pattern of the gains (up to 4 modes).
-        for signs in 0..patterns {
-            for a in [0.0, 2.0] {
-                let c0 = direct / (f[problem.bins[0]] / problem.f_ref).powf(0.5 * a);
-                for c in [c0, -c0, 0.0] {
-                    let x0 = start(seeds, signs, floor, c, a, &edge_start);
-                    if let Some(r) = problem.fit(&x0, m) {
-                        if best.as_ref().is_none_or(|b| r.0.rss < b.0.rss) {
-                            best = Some(r);
-                        }
-                    }
-                }
-            }
-        }
-        best
-    };
     let mut seeds = seeds.to_vec();
-    let mut best = run(&seeds)?;
-    // Residual search: one more mode at the largest positive residual away from the modes.
+    let mut best = best_fit(&problem, &seeds, floor, direct)?;
     while seeds.len() < max_modes {
-        let m = seeds.len();
-        let x = &best.0.x;
-        let mut model = Vec::new();
-        let kern = match input.window {
-            Some(w) if input.even => kernel(w, best.1),
-            _ => Vec::new(),
-        };
-        if !problem.eval(x, m, best.1, &kern, &mut model) {
+        let Some(seed) = residual_seed(&problem, &best.0.x, seeds.len(), best.1) else {
             break;
-        }
-        let res: Vec<f64> = problem
-            .logs
-            .iter()
-            .zip(&model)
-            .map(|(l, s)| l - s.ln())
-            .collect();
-        let n = res.len();
-        let sm: Vec<f64> = (0..n)
-            .map(|i| {
-                let a = i.saturating_sub(1);
-                let b = (i + 1).min(n - 1);
-                res[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
-            })
-            .collect();
-        let away = |fk: f64| {
-            (0..m).all(|i| {
-                let fi = x[3 * i].exp();
-                let w = (2.0 * x[3 * i + 1].exp() * fi).max(1.5 * df);
-                (fk - fi).abs() > w
-            })
-        };
-        let Some((i_max, &r_max)) = sm
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| away(f[problem.bins[*i]]))
-            .max_by(|a, b| a.1.total_cmp(b.1))
-        else {
-            break;
-        };
-        if r_max < 0.3 {
-            break;
-        }
-        let fk = f[problem.bins[i_max]];
-        let seed = Seed {
-            frequency_hz: fk,
-            damping: (1.5 * df / fk).max(0.02),
-            peak_psd: input.psd[problem.bins[i_max]] / problem.norm(fk),
-            peak: None,
         };
         let mut trial = seeds.clone();
         trial.push(seed);
-        let Some(candidate) = run(&trial) else {
+        let Some(candidate) = best_fit(&problem, &trial, floor, direct) else {
             break;
         };
-        let new = &candidate.0.x;
         let k = trial.len() - 1;
-        let stands = {
-            let fi = new[3 * k].exp();
-            let mut without = new.clone();
-            without[3 * k + 2] = 0.0;
-            let at = |x: &[f64]| {
-                response(
-                    x,
-                    trial.len(),
-                    problem.power,
-                    problem.f_ref,
-                    problem.edges,
-                    fi,
-                ) + x[3 * trial.len() + 2].exp()
-            };
-            10.0 * (at(new) / at(&without).max(1e-300)).log10() >= 3.0 && new[3 * k + 1].exp() < 0.3
-        };
-        if stands && bic(&candidate.0, n_eff) < bic(&best.0, n_eff) - 10.0 {
-            seeds = trial;
-            best = candidate;
-        } else {
+        let stands = problem.standing_db(&candidate.0.x, trial.len(), k) >= 3.0
+            && candidate.0.x[3 * k + 1].exp() < 0.3;
+        if !(stands && bic(&candidate.0, n_eff) < bic(&best.0, n_eff) - 10.0) {
             break;
         }
+        seeds = trial;
+        best = candidate;
     }
-    let (fit, q) = best;
+    Some(modes_of(&problem, &best.0, &seeds, (lo, hi)))
+}
+
+/// The fitted modes inside the range, with their uncertainties s²(JᵀJ)⁻¹ inflated by √ENBW.
+fn modes_of(
+    problem: &Problem,
+    fit: &FitResult,
+    seeds: &[Seed],
+    range: (f64, f64),
+) -> Vec<FittedMode> {
     let m = seeds.len();
-    let inflate = input.enbw_bins.max(1.0).sqrt();
-    let kern = match input.window {
-        Some(w) if input.even => kernel(w, q),
-        _ => Vec::new(),
-    };
+    let inflate = problem.input.enbw_bins.max(1.0).sqrt();
     let mut out = Vec::new();
-    for i in 0..m {
+    for (i, seed) in seeds.iter().enumerate() {
         let fi = fit.x[3 * i].exp();
         let z = fit.x[3 * i + 1].exp();
         let (Some(sf), Some(sz)) = (fit.sigma(3 * i), fit.sigma(3 * i + 1)) else {
             continue;
         };
-        if !(fi.is_finite() && fi > lo && fi < hi && z > 0.0 && z < 0.7) {
+        if !(fi.is_finite() && fi > range.0 && fi < range.1 && z > 0.0 && z < 0.7) {
             continue;
         }
-        // How far the mode stands over the model without it, at its frequency.
-        let mut without = fit.x.clone();
-        without[3 * i + 2] = 0.0;
-        let at = |x: &[f64]| {
-            response(x, m, problem.power, problem.f_ref, problem.edges, fi) + fit.x[3 * m + 2].exp()
-        };
-        let standing_db = 10.0 * (at(&fit.x) / at(&without).max(1e-300)).log10();
-        let _ = &kern;
         out.push(FittedMode {
             estimate: Estimate {
                 method: Method::SpectrumFit,
@@ -586,10 +546,10 @@ pub(crate) fn fit_modes(
                 frequency_uncertainty_hz: sf * inflate * fi,
                 damping_uncertainty: sz * inflate * z,
             },
-            peak: seeds[i].peak,
-            peak_psd: problem.norm(fi) * at(&fit.x),
-            standing_db,
+            peak: seed.peak,
+            peak_psd: problem.norm(fi) * problem.level(&fit.x, m, fi),
+            standing_db: problem.standing_db(&fit.x, m, i),
         });
     }
-    Some(out)
+    out
 }

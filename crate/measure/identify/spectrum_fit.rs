@@ -41,22 +41,11 @@ pub(super) fn kernel(kind: WindowKind, n: usize, q: usize, j_max: usize) -> Vec<
     out
 }
 
-/// Fits the modal spectrum to the PSD around the peaks; returns one estimate per mode.
-pub(super) fn spectrum_fit(
-    psd: &Psd,
-    initial: &[HalfPower],
-    lo: usize,
-    hi: usize,
-    kind: SignalKind,
-) -> Option<Vec<Estimate>> {
-    let m = initial.len();
+/// The bins fitted by [`spectrum_fit`]: from the lowest seed's −6ζ (30–90 %) to the highest's
+/// +6ζ (≥ 30 %) inside `lo..=hi`; all within ±3 half-power widths of a peak, the others thinned
+/// to about 1500; positive ones only.
+fn fit_bins(psd: &Psd, initial: &[HalfPower], lo: usize, hi: usize) -> Option<Vec<usize>> {
     let df = psd.resolution_hz;
-    let power = kind.power();
-    let fns: Vec<f64> = initial.iter().map(|h| h.estimate.frequency_hz).collect();
-    let zs: Vec<f64> = initial
-        .iter()
-        .map(|h| h.estimate.damping.clamp(1e-4, 0.6))
-        .collect();
     let f_lo = initial
         .iter()
         .map(|h| h.estimate.frequency_hz * (1.0 - (6.0 * h.estimate.damping).clamp(0.3, 0.9)))
@@ -70,7 +59,6 @@ pub(super) fn spectrum_fit(
     if b <= a + 8 {
         return None;
     }
-    // Bins: all within ±3 half-power widths of a peak, the others thinned to ~1500.
     let near = |k: usize| {
         let f = k as f64 * df;
         initial
@@ -92,9 +80,54 @@ pub(super) fn spectrum_fit(
         }
     }
     let bins: Vec<usize> = bins.into_iter().filter(|&k| psd.psd[k] > 0.0).collect();
-    if bins.len() < 3 * m + 4 {
-        return None;
+    (bins.len() >= 3 * initial.len() + 4).then_some(bins)
+}
+
+/// Starting parameters from the half-power seeds, gain signs from `signs` (bit i−1 flips
+/// mode i), and the finite-difference steps.
+fn start(initial: &[HalfPower], signs: usize, floor0: f64) -> (Vec<f64>, Vec<f64>) {
+    let m = initial.len();
+    let mut x0 = Vec::with_capacity(3 * m + 1);
+    for (i, h) in initial.iter().enumerate() {
+        let sign = if i > 0 && (signs >> (i - 1)) & 1 == 1 {
+            -1.0
+        } else {
+            1.0
+        };
+        let z = h.estimate.damping.clamp(1e-4, 0.6);
+        x0.push(h.estimate.frequency_hz.ln());
+        x0.push(z.ln());
+        x0.push(sign * h.peak_psd.sqrt() * 2.0 * z);
     }
+    x0.push(floor0.ln());
+    let steps = (0..3 * m + 1)
+        .map(|i| {
+            if i == 3 * m {
+                1e-5
+            } else if i % 3 == 0 {
+                1e-7
+            } else if i % 3 == 1 {
+                1e-5
+            } else {
+                1e-6 * x0[i].abs().max(1e-300)
+            }
+        })
+        .collect();
+    (x0, steps)
+}
+
+/// Fits the modal spectrum to the PSD around the peaks; returns one estimate per mode.
+pub(super) fn spectrum_fit(
+    psd: &Psd,
+    initial: &[HalfPower],
+    lo: usize,
+    hi: usize,
+    kind: SignalKind,
+) -> Option<Vec<Estimate>> {
+    let m = initial.len();
+    let df = psd.resolution_hz;
+    let power = kind.power();
+    let bins = fit_bins(psd, initial, lo, hi)?;
     // Leakage kernel near narrow peaks (half-power width below 12 bins).
     let (q, j_max) = (4usize, 16usize);
     let narrow: Vec<&HalfPower> = initial.iter().filter(|h| h.width_hz < 12.0 * df).collect();
@@ -142,31 +175,7 @@ pub(super) fn spectrum_fit(
     };
     let mut best: Option<crate::measure::fit::FitResult> = None;
     for signs in 0..(1usize << (m - 1)) {
-        let mut x0 = Vec::with_capacity(3 * m + 1);
-        for i in 0..m {
-            let sign = if i > 0 && (signs >> (i - 1)) & 1 == 1 {
-                -1.0
-            } else {
-                1.0
-            };
-            x0.push(fns[i].ln());
-            x0.push(zs[i].ln());
-            x0.push(sign * initial[i].peak_psd.sqrt() * 2.0 * zs[i]);
-        }
-        x0.push(floor0.ln());
-        let steps: Vec<f64> = (0..3 * m + 1)
-            .map(|i| {
-                if i == 3 * m {
-                    1e-5
-                } else if i % 3 == 0 {
-                    1e-7
-                } else if i % 3 == 1 {
-                    1e-5
-                } else {
-                    1e-6 * x0[i].abs().max(1e-300)
-                }
-            })
-            .collect();
+        let (x0, steps) = start(initial, signs, floor0);
         if let Some(fit) = levenberg_marquardt(model, &x0, &steps, 60) {
             if best.as_ref().is_none_or(|b| fit.rss < b.rss) {
                 best = Some(fit);

@@ -1,0 +1,304 @@
+//! The stages of [`identify`](super::identify) on a raw recording: the detection PSD and the
+//! band, the spectrum the modes are fitted on (a Welch PSD whose segments suit the peaks, or a
+//! sweep's whole-record periodogram inside its band), the peaks' half-power seeds, and the
+//! free decay.
+
+use super::decay::{decay_fit, find_decay};
+use super::half_power::{half_power, smoothed, HalfPower};
+use super::peaks::{detect, Peak};
+use super::sweep::Sweep;
+use super::{FreeDecay, IdentifyOptions, Slot};
+use crate::error::{count, positive, Error, Result};
+use crate::measure::psd::{welch, Detrend, Psd, Scaling, WelchOptions, WindowKind};
+
+/// What the fits start from: the spectrum, its peaks with their half-power seeds (one per
+/// maximum), and the band fitted.
+pub(super) struct Stage {
+    pub psd: Psd,
+    pub found: Vec<(Peak, HalfPower)>,
+    pub band: [f64; 2],
+}
+
+fn pow2_floor(n: usize) -> usize {
+    if n == 0 {
+        0
+    } else {
+        1usize << (usize::BITS - 1 - n.leading_zeros())
+    }
+}
+
+fn hann_welch(fs: f64, segment: usize) -> WelchOptions {
+    WelchOptions {
+        sample_rate_hz: fs,
+        segment_length: Some(segment),
+        overlap: Some(segment / 2),
+        window: WindowKind::Hann,
+        kaiser_beta: 6.0,
+        symmetric_window: false,
+        detrend: Detrend::Constant,
+        scaling: Scaling::Density,
+    }
+}
+
+/// The detection PSD (Hann, half overlap, `segmentLength` or 2^⌊log₂(n/4)⌋ samples) and its
+/// segment length.
+pub(super) fn detection_psd(
+    signal: &[f64],
+    fs: f64,
+    options: &IdentifyOptions,
+) -> Result<(Psd, usize)> {
+    let n = signal.len();
+    let n0 = match options.segment_length {
+        Some(s) => {
+            count("segmentLength", s, 64, n)?;
+            s
+        }
+        None => pow2_floor(n / 4).clamp(64, 65536),
+    };
+    Ok((welch(signal, &hann_welch(fs, n0))?, n0))
+}
+
+/// The band searched: the options' or [3 bins, 0.45 f_s].
+pub(super) fn search_band(options: &IdentifyOptions, fs: f64, df0: f64) -> Result<[f64; 2]> {
+    let f_lo = match options.min_frequency_hz {
+        Some(f) => positive("minFrequencyHz", f)?,
+        None => 3.0 * df0,
+    };
+    let f_hi = match options.max_frequency_hz {
+        Some(f) => positive("maxFrequencyHz", f)?,
+        None => 0.45 * fs,
+    };
+    if f_hi > 0.5 * fs {
+        return Err(Error::invalid(
+            "maxFrequencyHz",
+            format!("must not exceed half the sample rate, {} Hz", 0.5 * fs),
+        ));
+    }
+    if f_lo >= f_hi {
+        return Err(Error::invalid(
+            "minFrequencyHz",
+            format!("must be below maxFrequencyHz ({f_hi} Hz), got {f_lo}"),
+        ));
+    }
+    Ok([f_lo, f_hi])
+}
+
+fn bins(psd: &Psd, band: [f64; 2]) -> (usize, usize) {
+    let bin = |f: f64| ((f / psd.resolution_hz).round() as usize).min(psd.psd.len() - 1);
+    (bin(band[0]).max(1), bin(band[1]))
+}
+
+/// The half-power analysis of each peak on `psd`, on the spectrum averaged over a tenth of the
+/// peak's width so that the bins' noise does not move the crossings: from a heavy average down
+/// to that. `search_hz` is the least search radius around a peak.
+fn half_powers(
+    psd: &Psd,
+    peaks: &[Peak],
+    band: [f64; 2],
+    search_hz: f64,
+    options: &IdentifyOptions,
+) -> Vec<Option<HalfPower>> {
+    let (lo, hi) = bins(psd, band);
+    peaks
+        .iter()
+        .map(|p| {
+            let search = search_hz.max(0.02 * p.frequency_hz);
+            let mut h = ((hi - lo) / 100).clamp(3, 2000);
+            let mut found = None;
+            for _ in 0..10 {
+                let Some(hp) = half_power(
+                    &smoothed(psd, h),
+                    p.frequency_hz,
+                    search,
+                    lo,
+                    hi,
+                    options.signal,
+                ) else {
+                    break;
+                };
+                found = Some(hp);
+                let next = ((hp.width_hz / psd.resolution_hz) / 10.0).floor() as usize;
+                if next + 1 >= h && next <= h + 1 {
+                    break;
+                }
+                h = next.min(2000);
+            }
+            found
+        })
+        .collect()
+}
+
+/// Pairs the peaks with their half-power seeds; peaks that collapse onto the same maximum are
+/// one mode.
+fn unique(peaks: &[Peak], widths: &[Option<HalfPower>]) -> Vec<(Peak, HalfPower)> {
+    let mut out: Vec<(Peak, HalfPower)> = Vec::new();
+    for (p, h) in peaks.iter().zip(widths) {
+        let Some(h) = h else { continue };
+        if !out
+            .iter()
+            .any(|(_, o)| (o.peak_hz - h.peak_hz).abs() < 0.5 * o.width_hz.min(h.width_hz))
+        {
+            out.push((*p, *h));
+        }
+    }
+    out
+}
+
+/// The Welch path: peaks of the detection PSD, then segments from the record and the peaks:
+/// the narrowest half-power width should span 4 to 12 bins (the fit models the window's
+/// smearing, so a few bins suffice, and shorter segments average more of them). Longer while
+/// it spans fewer (up to n/4), or once shorter when it spans more (down to 64 samples). None
+/// when no peak stands out.
+pub(super) fn welch_stage(
+    signal: &[f64],
+    psd0: Psd,
+    n0: usize,
+    band: [f64; 2],
+    options: &IdentifyOptions,
+) -> Result<Option<Stage>> {
+    let fs = psd0.sample_rate_hz;
+    let df0 = psd0.resolution_hz;
+    let (lo0, hi0) = bins(&psd0, band);
+    if hi0 <= lo0 + 4 {
+        return Ok(None);
+    }
+    let peaks = detect(
+        &psd0,
+        lo0,
+        hi0,
+        options.min_prominence_db,
+        options.max_modes,
+        3,
+    );
+    if peaks.is_empty() {
+        return Ok(None);
+    }
+    let n_max = pow2_floor(signal.len() / 4).max(n0).min(1 << 20);
+    let mut psd = psd0;
+    let (mut seg, mut shrunk) = (n0, false);
+    let widths = loop {
+        let widths = half_powers(&psd, &peaks, band, 4.0 * df0, options);
+        let narrowest = widths
+            .iter()
+            .flatten()
+            .map(|h| h.width_hz / psd.resolution_hz)
+            .fold(f64::INFINITY, f64::min);
+        if !narrowest.is_finite() {
+            break widths;
+        }
+        if narrowest > 12.0 && !shrunk && seg > 64 {
+            shrunk = true;
+            let factor = pow2_floor((narrowest / 6.0).floor() as usize).max(1);
+            seg = (seg / factor).max(64);
+        } else if narrowest < 4.0 && !shrunk && seg < n_max {
+            let factor = (8.0 / narrowest).ceil() as usize;
+            seg = (seg * factor.next_power_of_two()).min(n_max);
+        } else {
+            break widths;
+        }
+        psd = welch(signal, &hann_welch(fs, seg))?;
+    };
+    let found = unique(&peaks, &widths);
+    Ok(Some(Stage { psd, found, band }))
+}
+
+/// The sweep path: the whole record's periodogram (rectangular window, linear trend removed:
+/// the sensor's drift), searched and fitted inside the swept band less a margin at each end
+/// where the excitation's spectrum is not smooth (a linear chirp's spectrum ripples within
+/// about √r of its ends, r the sweep rate in Hz/s; at least 4 bins). The peaks are those of
+/// the periodogram smoothed over about √r/4. None when the band is empty or nothing stands
+/// out in it (the Welch path then runs).
+pub(super) fn sweep_stage(
+    signal: &[f64],
+    fs: f64,
+    sweep: Sweep,
+    band: [f64; 2],
+    options: &IdentifyOptions,
+) -> Result<Option<Stage>> {
+    let n = signal.len();
+    let psd = welch(
+        signal,
+        &WelchOptions {
+            sample_rate_hz: fs,
+            segment_length: Some(n),
+            overlap: Some(0),
+            window: WindowKind::Rectangular,
+            kaiser_beta: 6.0,
+            symmetric_window: false,
+            detrend: Detrend::Linear,
+            scaling: Scaling::Density,
+        },
+    )?;
+    let df = psd.resolution_hz;
+    let root = sweep.rate_hz_per_s.sqrt();
+    let margin = root.max(4.0 * df);
+    let fit_band = [
+        band[0].max(sweep.band_hz[0] + margin),
+        band[1].min(sweep.band_hz[1] - margin),
+    ];
+    let (lo, hi) = bins(&psd, fit_band);
+    if hi <= lo + 16 {
+        return Ok(None);
+    }
+    let h = ((0.125 * root / df).round() as usize).clamp(1, 200);
+    let peaks = detect(
+        &psd,
+        lo,
+        hi,
+        options.min_prominence_db,
+        options.max_modes,
+        h,
+    );
+    if peaks.is_empty() {
+        return Ok(None);
+    }
+    let widths = half_powers(&psd, &peaks, fit_band, (2 * h + 1) as f64 * df, options);
+    let found = unique(&peaks, &widths);
+    if found.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(Stage {
+        psd,
+        found,
+        band: fit_band,
+    }))
+}
+
+/// Stage 4: when the recording rings down after a hit, the free-decay fit of every slot's
+/// mode joins its estimates (when it agrees with the first one within 20 %).
+pub(super) fn free_decay_stage(signal: &[f64], fs: f64, slots: &mut [Slot]) -> Option<FreeDecay> {
+    let lowest = slots
+        .iter()
+        .map(|s| s.estimates[0].frequency_hz)
+        .fold(f64::INFINITY, f64::min);
+    let (start, end, level_db) = find_decay(signal, fs, lowest)?;
+    let initial: Vec<(f64, f64)> = slots
+        .iter()
+        .map(|s| {
+            let best = s.estimates.last().copied().unwrap_or(s.estimates[0]);
+            (best.frequency_hz, best.damping)
+        })
+        .collect();
+    let f_max = initial.iter().map(|p| p.0).fold(0.0, f64::max);
+    let mut stride = 1;
+    while (end - start) / stride > 40_000 && fs / (stride as f64 * 2.0) > 3.0 * f_max {
+        stride *= 2;
+    }
+    let y: Vec<f64> = signal[start..end].iter().step_by(stride).copied().collect();
+    let end = start + y.len() * stride;
+    let decays = decay_fit(&y, fs / stride as f64, &initial)?;
+    for (slot, d) in slots.iter_mut().zip(decays) {
+        let f0 = slot.estimates[0].frequency_hz;
+        let agrees = (d.frequency_hz - f0).abs() < 0.2 * f0
+            && d.damping > 0.0
+            && d.damping_uncertainty.is_finite();
+        if agrees {
+            slot.estimates.push(d);
+        }
+    }
+    Some(FreeDecay {
+        start_s: start as f64 / fs,
+        end_s: end as f64 / fs,
+        level_db,
+    })
+}

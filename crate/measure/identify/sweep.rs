@@ -1,0 +1,195 @@
+//! Stage 0 for raw recordings: is the excitation a sweep, and which band does it cover?
+//!
+//! Klipper's resonance test (klippy/extras/resonance_tester.py, `VibrationPulseTestGenerator.
+//! gen_test`, run by `ResonanceTestExecutor.run_test`) drives the toolhead with an acceleration
+//! of ±`accel_per_hz`·f that changes sign every quarter period of f, f rising by `hz_per_sec`
+//! per second from `freq_start` to `freq_end`: a square wave whose frequency rises linearly in
+//! time. Newer versions (`SweepingVibrationsTestGenerator.gen_test`) add a slow ±`sweeping_accel`
+//! square wave of period `sweeping_period` (≈ 0.8 Hz and its odd harmonics). What the sensor
+//! sees at any moment is dominated by the response at the current drive frequency f(t).
+//!
+//! The sweep is read from the data itself, not from the test's parameters: short Hann frames
+//! (about 1 s, a quarter-frame hop), the strongest bin of each (above the second bin, where the
+//! slow component and drift sit) interpolated in log power, and a straight line f(t) = f₀ + r·t
+//! fitted robustly (Theil–Sen slope, then least squares over the frames within two bins of it).
+//! A recording is a sweep when the line holds for most frames and spans at least eight frame
+//! bins. Its band is the line over the inlying frames, widened by half a frame's worth of sweep
+//! at each end (a frame's ridge is the mean frequency over the frame).
+//!
+//! Why it matters: a Welch average of a sweep with segments shorter than the record is lumpy
+//! (each segment sees a few hertz of the sweep), and outside the swept band the PSD is noise and
+//! harmonics, not the modal response. The whole record's periodogram of a sweep is
+//! |H(f)|²·|A(f)|², with |A(f)|² smooth inside the band (stationary phase: every frequency is
+//! passed once, for a time ∝ 1/r, at an amplitude ∝ f), so identify fits that periodogram,
+//! inside the band.
+
+use crate::measure::fft::{Complex, Fft};
+use crate::measure::psd::{window, WindowKind};
+use serde::Serialize;
+
+/// A sweep found in a recording (JS: `{ bandHz, rateHzPerS }`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Sweep {
+    /// Lowest and highest frequency swept, Hz.
+    pub band_hz: [f64; 2],
+    /// Sweep rate, Hz/s (its magnitude).
+    pub rate_hz_per_s: f64,
+}
+
+/// The ridge of each frame: (frame centre s, frequency Hz), frames with power.
+fn ridge(signal: &[f64], fs: f64, len: usize) -> Vec<(f64, f64)> {
+    let hop = (len / 4).max(1);
+    let w = window(WindowKind::Hann, len, false, 0.0);
+    let mut plan = Fft::new(len);
+    let mut data = vec![Complex::default(); len];
+    let mut frames = Vec::new();
+    let mut start = 0;
+    while start + len <= signal.len() {
+        let seg = &signal[start..start + len];
+        let mean = seg.iter().sum::<f64>() / len as f64;
+        for (d, (v, wi)) in data.iter_mut().zip(seg.iter().zip(&w)) {
+            *d = Complex::new((v - mean) * wi, 0.0);
+        }
+        plan.forward(&mut data);
+        let p: Vec<f64> = data[..len / 2].iter().map(|z| z.norm_sqr()).collect();
+        let total: f64 = p[2..].iter().sum();
+        if let Some(k) = (3..len / 2 - 1).max_by(|&a, &b| p[a].total_cmp(&p[b])) {
+            let (ym, y0, yp) = (
+                p[k - 1].max(1e-300).ln(),
+                p[k].max(1e-300).ln(),
+                p[k + 1].max(1e-300).ln(),
+            );
+            let den = ym - 2.0 * y0 + yp;
+            let delta = if den < 0.0 {
+                (0.5 * (ym - yp) / den).clamp(-0.5, 0.5)
+            } else {
+                0.0
+            };
+            frames.push((
+                (start as f64 + 0.5 * len as f64) / fs,
+                (k as f64 + delta) * fs / len as f64,
+                total,
+            ));
+        }
+        start += hop;
+    }
+    // Frames with less than 1 % of the median power are idle (before or after the test).
+    let mut powers: Vec<f64> = frames.iter().map(|f| f.2).collect();
+    powers.sort_by(f64::total_cmp);
+    let median = powers.get(powers.len() / 2).copied().unwrap_or(0.0);
+    frames
+        .into_iter()
+        .filter(|f| f.2 >= 0.01 * median)
+        .map(|f| (f.0, f.1))
+        .collect()
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Least squares line through points: (intercept, slope).
+fn line(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let n = points.len() as f64;
+    let (st, sf) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0, b + p.1));
+    let (mt, mf) = (st / n, sf / n);
+    let (sxx, sxy) = points.iter().fold((0.0, 0.0), |(a, b), p| {
+        (a + (p.0 - mt).powi(2), b + (p.0 - mt) * (p.1 - mf))
+    });
+    (sxx > 0.0).then(|| (mf - sxy / sxx * mt, sxy / sxx))
+}
+
+/// Finds a linear sweep in `signal` sampled at `fs` (see the module docs); None when the
+/// excitation is not one (noise, a hit, a record shorter than 8 frames).
+pub(super) fn detect_sweep(signal: &[f64], fs: f64) -> Option<Sweep> {
+    let len = (fs.round() as usize).next_power_of_two().clamp(64, 1 << 16);
+    if signal.len() < 4 * len {
+        return None;
+    }
+    let frames = ridge(signal, fs, len);
+    let n = frames.len();
+    if n < 8 {
+        return None;
+    }
+    // Theil–Sen: the median of the pairwise slopes, over at most 400 evenly spread frames (a
+    // long record would otherwise make millions of pairs).
+    let picked: Vec<(f64, f64)> = frames.iter().step_by(n.div_ceil(400)).copied().collect();
+    let p = picked.len();
+    let mut slopes = Vec::with_capacity(p * (p - 1) / 2);
+    for i in 0..p {
+        for j in i + 1..p {
+            slopes.push((picked[j].1 - picked[i].1) / (picked[j].0 - picked[i].0));
+        }
+    }
+    let r0 = median(&mut slopes);
+    let mut offsets: Vec<f64> = frames.iter().map(|p| p.1 - r0 * p.0).collect();
+    let b0 = median(&mut offsets);
+    let bin = fs / len as f64;
+    let inliers: Vec<(f64, f64)> = frames
+        .iter()
+        .copied()
+        .filter(|p| (p.1 - b0 - r0 * p.0).abs() <= 2.0 * bin)
+        .collect();
+    if inliers.len() < 8 || (inliers.len() as f64) < 0.6 * n as f64 {
+        return None;
+    }
+    let (b, r) = line(&inliers)?;
+    let t0 = inliers.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+    let t1 = inliers.iter().map(|p| p.0).fold(0.0, f64::max);
+    let half = 0.5 * len as f64 / fs * r.abs();
+    let (fa, fb) = (b + r * t0, b + r * t1);
+    let band = [fa.min(fb) - half, fa.max(fb) + half];
+    if band[1] - band[0] < 8.0 * bin || band[0] <= 0.0 {
+        return None;
+    }
+    Some(Sweep {
+        band_hz: band,
+        rate_hz_per_s: r.abs(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A square wave whose frequency rises from 20 to 80 Hz at 4 Hz/s (Klipper's kind of test):
+    /// the band and the rate come back; white noise and a steady tone are not sweeps.
+    #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
+    fn finds_a_linear_sweep_and_nothing_else() {
+        let fs = 2000.0;
+        let (f0, r, dur) = (20.0, 4.0, 15.0);
+        let n = (dur * fs) as usize;
+        let x: Vec<f64> = (0..n)
+            .map(|i| {
+                let t = i as f64 / fs;
+                let phase = f0 * t + 0.5 * r * t * t;
+                let f = f0 + r * t;
+                f * (2.0 * std::f64::consts::PI * phase).sin().signum()
+            })
+            .collect();
+        let s = detect_sweep(&x, fs).unwrap();
+        assert!((s.rate_hz_per_s - r).abs() < 0.05 * r, "{s:?}");
+        assert!((s.band_hz[0] - f0).abs() < 2.0, "{s:?}");
+        assert!((s.band_hz[1] - (f0 + r * dur)).abs() < 2.0, "{s:?}");
+        // A tone: no slope.
+        let tone: Vec<f64> = (0..n)
+            .map(|i| (2.0 * std::f64::consts::PI * 37.0 * i as f64 / fs).sin())
+            .collect();
+        assert!(detect_sweep(&tone, fs).is_none());
+        // Noise (a fixed linear congruential sequence): no line.
+        let mut state = 12345u64;
+        let noise: Vec<f64> = (0..n)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect();
+        assert!(detect_sweep(&noise, fs).is_none());
+    }
+}
