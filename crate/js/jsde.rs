@@ -447,25 +447,33 @@ impl De {
         Some(v.to_vec())
     }
 
+    /// The error for a value of the wrong type. Unlike serde-wasm-bindgen, which formats
+    /// anything else with `{:?}` (the whole of an array: seconds for a sparse
+    /// `new Array(2 ** 27)`) and copies binary data to say "byte array", this names what the
+    /// value is ([`super::args::describe`]) and quotes at most 40 characters of a string, so
+    /// that the error costs the same whatever was passed (issue 21).
     #[cold]
     fn invalid_type_(&self, visitor: &dyn de::Expected) -> Error {
-        let string;
-        let bytes;
+        let string: String;
         let unexpected = if self.is_nullish() {
             de::Unexpected::Unit
         } else if let Some(v) = self.value.as_bool() {
             de::Unexpected::Bool(v)
         } else if let Some(v) = self.value.as_f64() {
             de::Unexpected::Float(v)
-        } else if let Some(v) = self.value.as_string() {
-            string = v;
+        } else if let Some(v) = self.value.dyn_ref::<JsString>() {
+            string = if v.length() > 40 {
+                format!("{}…", String::from(v.slice(0, 40)))
+            } else {
+                String::from(v)
+            };
             de::Unexpected::Str(&string)
-        } else if let Some(v) = self.as_bytes() {
-            bytes = v;
-            de::Unexpected::Bytes(&bytes)
+        } else if self.value.is_instance_of::<Uint8Array>()
+            || self.value.is_instance_of::<ArrayBuffer>()
+        {
+            de::Unexpected::Other("byte array")
         } else {
-            string = format!("{:?}", self.value);
-            de::Unexpected::Other(&string)
+            de::Unexpected::Other(super::args::describe(&self.value))
         };
         de::Error::invalid_type(unexpected, visitor)
     }
