@@ -91,7 +91,9 @@ fn too_long(field: &str, length: usize) -> Error {
 /// [`MAX_ARRAY_LENGTH`] long, naming `field[i]` for an element that is not a number. A typed
 /// array on a detached buffer reads as empty (its length is 0).
 pub(crate) fn f64_vec(value: &JsValue, field: &str) -> Result<Vec<f64>, Error> {
-    if let Some(a) = value.dyn_ref::<js_sys::Float64Array>() {
+    // `instanceof` alone would take a Proxy of a typed array, whose `length` then throws.
+    let view = js_sys::ArrayBuffer::is_view(value);
+    if let Some(a) = value.dyn_ref::<js_sys::Float64Array>().filter(|_| view) {
         let n = a.length() as usize;
         if n > MAX_ARRAY_LENGTH {
             return Err(too_long(field, n));
@@ -99,7 +101,7 @@ pub(crate) fn f64_vec(value: &JsValue, field: &str) -> Result<Vec<f64>, Error> {
         // A typed array on a detached buffer has length 0, and copying from it throws.
         return Ok(if n == 0 { Vec::new() } else { a.to_vec() });
     }
-    if let Some(a) = value.dyn_ref::<js_sys::Float32Array>() {
+    if let Some(a) = value.dyn_ref::<js_sys::Float32Array>().filter(|_| view) {
         let n = a.length() as usize;
         if n > MAX_ARRAY_LENGTH {
             return Err(too_long(field, n));
@@ -133,4 +135,23 @@ pub(crate) fn f64_vec(value: &JsValue, field: &str) -> Result<Vec<f64>, Error> {
         value,
         "a Float64Array or an array of numbers",
     ))
+}
+
+#[wasm_bindgen::prelude::wasm_bindgen]
+extern "C" {
+    /// `Object.assign(target, source)`, its exception caught (a getter or a Proxy trap of
+    /// `source` may throw).
+    #[wasm_bindgen(catch, js_namespace = Object, js_name = assign)]
+    fn try_assign(target: &js_sys::Object, source: &JsValue) -> Result<JsValue, JsValue>;
+}
+
+/// A copy of the object `value` (its own enumerable properties), or a parse error naming
+/// `field` when reading them throws.
+pub(crate) fn copy_object(value: &JsValue, field: &str) -> Result<js_sys::Object, Error> {
+    let copy = js_sys::Object::new();
+    try_assign(&copy, value).map_err(|_| Error::Parse {
+        field: field.to_string(),
+        reason: "could not be read (a getter or a Proxy trap threw)".into(),
+    })?;
+    Ok(copy)
 }

@@ -413,11 +413,12 @@ pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, J
 /// `identifyModes`' options without `channel` (not an [`IdentifyOptions`] field: the others are
 /// read from a copy without it).
 fn identify_options(options: &JsValue) -> Result<IdentifyOptions, Error> {
-    let copy = js_sys::Object::new();
-    if options.is_object() {
-        let _ = js_sys::Object::assign(&copy, options.unchecked_ref());
-        let _ = js_sys::Reflect::delete_property(&copy, &"channel".into());
-    }
+    let copy = if options.is_object() {
+        args::copy_object(options, "options")?
+    } else {
+        js_sys::Object::new()
+    };
+    let _ = js_sys::Reflect::delete_property(&copy, &"channel".into());
     from_js(copy.into(), "options")
 }
 
