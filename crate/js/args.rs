@@ -9,6 +9,9 @@
 //!
 //! Long arrays are copied into the module only after their length is checked
 //! ([`MAX_ARRAY_LENGTH`]): a sparse `new Array(2 ** 32 - 1)` would otherwise ask for 32 GB.
+//!
+//! A build with only some of the export groups (Cargo features) leaves some readers unused.
+#![cfg_attr(not(feature = "js-api"), allow(dead_code))]
 
 use crate::error::Error;
 use wasm_bindgen::{JsCast, JsValue};

@@ -17,6 +17,20 @@ use wasm_bindgen::{JsCast, JsValue};
 
 type Result<T> = std::result::Result<T, Error>;
 
+#[wasm_bindgen::prelude::wasm_bindgen]
+extern "C" {
+    /// `Object.entries(object)`, its exception caught: a getter or a Proxy trap may throw
+    /// (issue 21), which is then an error of the value, not an exception through the module.
+    #[wasm_bindgen(catch, js_namespace = Object, js_name = entries)]
+    fn try_entries(object: &JsValue) -> std::result::Result<Array, JsValue>;
+}
+
+/// [`try_entries`], a throw reported as an error of the value.
+fn entries_of(object: &JsValue) -> Result<Array> {
+    try_entries(object)
+        .map_err(|_| de::Error::custom("could not be read (a getter or a Proxy trap threw)"))
+}
+
 /// One step of the path: an element index, a map key (or enum variant), or a non-string key.
 enum Segment {
     Index(usize),
@@ -552,7 +566,7 @@ impl De {
             Some(iter) => visitor.visit_map(MapAccess::new(MapSource::Iter(iter))),
             None => {
                 if self.value.is_object() {
-                    let entries = Object::entries(self.value.unchecked_ref());
+                    let entries = entries_of(&self.value)?;
                     let len = entries.length();
                     visitor.visit_map(MapAccess::new(MapSource::Entries {
                         entries,
@@ -629,8 +643,12 @@ impl De {
                 payload: JsValue::UNDEFINED,
                 tag_field: None,
             }
-        } else if self.value.is_object() {
-            let entries = Object::entries(self.value.unchecked_ref());
+        } else if self.value.is_object()
+            // Not `Object.entries` of a typed array: one entry per element, 2^26 of them for
+            // a long signal (issue 21's fuzz: gigabytes for `firmware: new Float32Array(…)`).
+            && !ArrayBuffer::is_view(&self.value)
+        {
+            let entries = entries_of(&self.value)?;
             if entries.length() != 1 {
                 return Err(de::Error::invalid_length(entries.length() as _, &"1"));
             }

@@ -233,7 +233,7 @@ function plant(value, hostile, r, path) {
  * first few of each bad outcome, with the call that gave it) and whether every export still
  * answers its valid call as before (`stillAnswering`, `unchanged`).
  */
-export function fuzz(api, { calls = 2000, seed = 20261204, env = { canvas: () => null } } = {}) {
+export function fuzz(api, { calls = 2000, seed = 20261204, env = { canvas: () => null }, onCall = null } = {}) {
   const table = exportsTable(env).filter((e) => typeof api[e.cls ? 'RecordingParser' : e.name] === 'function');
   const values = HOSTILE.map(([label, make]) => [label, make]);
   const r = rng(seed);
@@ -289,6 +289,7 @@ export function fuzz(api, { calls = 2000, seed = 20261204, env = { canvas: () =>
     }
     let thrown = false;
     let error;
+    onCall?.(n, e.name, call);
     const t0 = performance.now();
     try { invoke(api, e, args, state); } catch (err) { thrown = true; error = err; }
     const dt = performance.now() - t0;
