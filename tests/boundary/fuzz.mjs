@@ -146,7 +146,8 @@ function exportsTable(env) {
     { name: 'recommendShaper', names: ['spectrum', 'modes', 'options'], args: () => [spectrum(), [mode()], { families: [{ family: 'zv' }, { family: 'ei', vtol: 0.05 }] }] },
     { name: 'firmwareConfig', names: ['request'], args: () => [{ firmware: 'klipper', axes: [{ axis: 'x', family: 'mzv', frequencyHz: 53.8 }] }] },
     { name: 'drawSpectrum', names: ['canvas', 'spectrum', 'options'], canvas: true, args: () => [env.canvas(), spectrum(), { peaksHz: [40] }] },
-    { name: 'drawKlipperChart', names: ['canvas', 'data', 'options'], canvas: true, args: () => { const s = spectrum(); return [env.canvas(), { frequencyHz: s.frequencyHz, psdSum: s.psd }, { maxHz: 150 }]; } },
+    // Its data's fields are named by their keys (`frequencyHz`, `shapers[0].values`), as documented.
+    { name: 'drawKlipperChart', names: ['canvas', 'data', 'options'], canvas: true, aliases: { data: ['frequencyHz', 'psdSum', 'psdX', 'psdY', 'psdZ', 'after', 'shapers'] }, args: () => { const s = spectrum(); return [env.canvas(), { frequencyHz: s.frequencyHz, psdSum: s.psd }, { maxHz: 150 }]; } },
     // The class: its constructor, and its methods on a live parser (a new one after `finish`).
     { name: 'new RecordingParser', names: ['options'], cls: 'new', args: () => [{ fileName: 'x.csv' }] },
     { name: 'RecordingParser.push', names: ['chunk'], aliases: { chunk: ['recording'] }, cls: 'push', args: () => [text.slice(0, text.indexOf('\n', 200) + 1)] },
