@@ -100,7 +100,8 @@ fn damping_curve_and_band_match_the_closed_form() {
         assert!((v - zv_undamped_design_on_damped_plant(*zeta)).abs() < 1e-12);
     }
     let band =
-        wasm::damping_insensitivity(shaper, js(r#"{"frequencyHz":1,"damping":0}"#), 0.05).unwrap();
+        wasm::damping_insensitivity(shaper, js(r#"{"frequencyHz":1,"damping":0}"#), 0.05.into())
+            .unwrap();
     let (lo, hi) = (
         get(&band, "lowDamping").as_f64().unwrap(),
         get(&band, "highDamping").as_f64().unwrap(),
@@ -120,7 +121,7 @@ fn damping_curve_and_band_match_the_closed_form() {
 fn robustness_table_defaults_to_parameterless_families_and_takes_specs() {
     let rows: Array = wasm::robustness_table(
         js(r#"{"frequencyHz":2,"damping":0}"#),
-        0.05,
+        0.05.into(),
         JsValue::UNDEFINED,
     )
     .unwrap()
@@ -144,7 +145,7 @@ fn robustness_table_defaults_to_parameterless_families_and_takes_specs() {
 
     let rows: Array = wasm::robustness_table(
         js(r#"{"frequencyHz":2,"damping":0}"#),
-        0.05,
+        0.05.into(),
         js(r#"[{"family":"zvdn","derivatives":3}]"#),
     )
     .unwrap()
@@ -193,13 +194,14 @@ fn analysis_errors_are_thrown_with_field_and_kind_and_the_module_keeps_working()
     );
     assert_eq!(field.as_deref(), Some("frequencyHz"), "{message}");
     let (message, field, _) = error_of(
-        wasm::damping_insensitivity(shaper.clone(), js(r#"{"frequencyHz":1}"#), 2.0).unwrap_err(),
+        wasm::damping_insensitivity(shaper.clone(), js(r#"{"frequencyHz":1}"#), 2.0.into())
+            .unwrap_err(),
     );
     assert_eq!(field.as_deref(), Some("vtol"), "{message}");
     let (message, field, _) = error_of(
         wasm::robustness_table(
             js(r#"{"frequencyHz":1}"#),
-            0.05,
+            0.05.into(),
             js(r#"[{"family":"zv"},{"family":"zvdn","derivatives":99}]"#),
         )
         .unwrap_err(),
@@ -208,12 +210,12 @@ fn analysis_errors_are_thrown_with_field_and_kind_and_the_module_keeps_working()
     let (message, _, kind) = error_of(
         wasm::robustness_table(
             js(r#"{"frequencyHz":1}"#),
-            0.05,
+            0.05.into(),
             js(r#"[{"family":"nope"}]"#),
         )
         .unwrap_err(),
     );
     assert_eq!(kind.as_deref(), Some("parse"), "{message}");
     // Still working.
-    assert!(wasm::damping_insensitivity(shaper, js(r#"{"frequencyHz":1}"#), 0.05).is_ok());
+    assert!(wasm::damping_insensitivity(shaper, js(r#"{"frequencyHz":1}"#), 0.05.into()).is_ok());
 }

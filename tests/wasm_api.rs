@@ -60,7 +60,8 @@ fn insensitivity_of_zv_at_zero_damping() {
         r#"{"family":"zv","modes":[{"frequencyHz":1,"damping":0}]}"#,
     ))
     .unwrap();
-    let band = wasm::insensitivity(shaper, js(r#"{"frequencyHz":1,"damping":0}"#), 0.05).unwrap();
+    let band =
+        wasm::insensitivity(shaper, js(r#"{"frequencyHz":1,"damping":0}"#), 0.05.into()).unwrap();
     let width = get(&band, "width").as_f64().unwrap();
     // Singhose 2009 Fig. 7: I(5 %) of ZV = 0.06 (exactly 2 − 4·acos(0.05)/π = 0.0637).
     assert!((width - 0.063_688_53).abs() < 1e-7, "{width}");
@@ -140,12 +141,19 @@ fn errors_inside_tagged_specs_name_the_field() {
         let (message, got) = error_message(wasm::design(js(spec)).unwrap_err());
         assert_eq!(got.as_deref(), Some(*field), "{spec}: {message}");
     }
-    // The tag missing, or the spec not an object: the spec itself is at fault.
+    // The tag missing, or the spec not an object: the spec itself is at fault, named `spec`
+    // (issue 21: every error names the argument).
     let (message, got) = error_message(wasm::design(js(&format!("{{{modes}}}"))).unwrap_err());
-    assert_eq!(got, None, "{message}");
+    assert_eq!(got.as_deref(), Some("spec"), "{message}");
     assert!(message.contains("missing field `family`"), "{message}");
-    let (message, _) = error_message(wasm::design(js(r#""zv""#)).unwrap_err());
+    let (message, got) = error_message(wasm::design(js(r#""zv""#)).unwrap_err());
     assert!(message.contains("invalid type: string"), "{message}");
+    assert_eq!(got.as_deref(), Some("spec"), "{message}");
+    let (message, got) = error_message(wasm::design(JsValue::NULL).unwrap_err());
+    assert_eq!(
+        (message.as_str(), got.as_deref()),
+        ("spec: is missing", Some("spec"))
+    );
 
     let plant = r#""plant":{"kind":"modal","modes":[{"frequencyHz":1,"damping":0.05}]}"#;
     let simulate_cases = [

@@ -331,7 +331,7 @@ fn analyses_kept_between_frames_follow_every_input_they_depend_on() {
             .as_f64()
             .unwrap();
         let expect = get(
-            &wasm::insensitivity(fresh.clone(), mode, vtol).unwrap(),
+            &wasm::insensitivity(fresh.clone(), mode, vtol.into()).unwrap(),
             &["width"],
         );
         assert_eq!(width, expect.as_f64().unwrap(), "edit {i}: I(Vtol)");

@@ -40,7 +40,7 @@ fn decay_csv() -> String {
 
 #[wasm_bindgen_test]
 fn parse_identify_recommend_round_trip() {
-    let rec = api::parse_recording(&decay_csv(), JsValue::UNDEFINED).unwrap();
+    let rec = api::parse_recording(decay_csv().into(), JsValue::UNDEFINED).unwrap();
     assert_eq!(get(&rec, "format").as_string().as_deref(), Some("klipper"));
     assert_eq!(get(&rec, "rows").as_f64(), Some(20_000.0));
     let channels: js_sys::Array = get(&rec, "channels").dyn_into().unwrap();
@@ -83,8 +83,8 @@ fn parse_identify_recommend_round_trip() {
 #[wasm_bindgen_test]
 fn chunked_parser_and_errors_with_line_and_column() {
     let mut p = api::JsRecordingParser::new(JsValue::UNDEFINED).unwrap();
-    p.push("time,a\n0,1\n0.5,").unwrap();
-    let e = p.push("x\n").unwrap_err();
+    p.push("time,a\n0,1\n0.5,".into()).unwrap();
+    let e = p.push("x\n".into()).unwrap_err();
     let err: js_sys::Error = e.dyn_into().unwrap();
     assert_eq!(get(&err, "line").as_f64(), Some(3.0));
     assert_eq!(get(&err, "column").as_f64(), Some(2.0));
@@ -93,7 +93,7 @@ fn chunked_parser_and_errors_with_line_and_column() {
     assert!(String::from(err.message()).contains("line 3, column 2 (`a`)"));
     // The module keeps working after an error.
     let mut p = api::JsRecordingParser::new(JsValue::UNDEFINED).unwrap();
-    p.push("time,a\n0,1\n1,2\n").unwrap();
+    p.push("time,a\n0,1\n1,2\n".into()).unwrap();
     assert_eq!(p.rows(), 2.0);
     assert!(p.finish().is_ok());
     assert!(p.finish().is_err(), "finish twice is an error, not a panic");
@@ -220,4 +220,84 @@ fn recommend_shaper_klipper_criterion_from_js() {
         .unwrap();
     let field = get(&e, "field").as_string().unwrap_or_default();
     assert!(field.starts_with("spectrum.normalization"), "{field}");
+}
+
+/// Arguments of the wrong type (issue 21 item 1): the documented `Error` naming the argument,
+/// checked in Rust (the glue no longer converts a `text` or a `chunk` first: a number there
+/// read out of bounds, `null` threw the glue's `TypeError`).
+#[wasm_bindgen_test]
+fn arguments_of_the_wrong_type_name_the_argument() {
+    let field_and_kind = |e: JsValue| {
+        let e: js_sys::Error = e.dyn_into().expect("an Error");
+        (
+            get(&e, "field").as_string().unwrap_or_default(),
+            get(&e, "kind").as_string().unwrap_or_default(),
+            String::from(e.message()),
+        )
+    };
+    for bad in [
+        JsValue::from(123),
+        JsValue::NULL,
+        JsValue::UNDEFINED,
+        js_sys::Object::new().into(),
+        js("[1, 2]"),
+    ] {
+        let (field, kind, message) =
+            field_and_kind(api::parse_recording(bad.clone(), JsValue::UNDEFINED).unwrap_err());
+        assert_eq!(
+            (field.as_str(), kind.as_str()),
+            ("text", "parse"),
+            "{message}"
+        );
+        let mut p = api::JsRecordingParser::new(JsValue::UNDEFINED).unwrap();
+        let (field, kind, message) = field_and_kind(p.push(bad).unwrap_err());
+        assert_eq!(
+            (field.as_str(), kind.as_str()),
+            ("chunk", "parse"),
+            "{message}"
+        );
+    }
+    let (_, _, message) =
+        field_and_kind(api::parse_recording(JsValue::from(1), JsValue::NULL).unwrap_err());
+    assert_eq!(message, "text: must be a string, got a number");
+    let (_, _, message) =
+        field_and_kind(api::parse_recording(JsValue::NULL, JsValue::NULL).unwrap_err());
+    assert_eq!(message, "text: must be a string, got null");
+    let (_, _, message) =
+        field_and_kind(api::parse_recording(JsValue::UNDEFINED, JsValue::NULL).unwrap_err());
+    assert_eq!(message, "text: is missing");
+    // Not a canvas (and there is none in Node): named `canvas`.
+    let spectrum = js(r#"{"frequencyHz":[0,1,2],"psd":[1,1,1]}"#);
+    for bad in [
+        JsValue::from(1),
+        JsValue::NULL,
+        js_sys::Object::new().into(),
+    ] {
+        let e = api::draw_klipper_chart(bad.clone(), spectrum.clone(), JsValue::UNDEFINED);
+        assert_eq!(field_and_kind(e.unwrap_err()).0, "canvas");
+    }
+    // An array is length-checked before it is copied: a sparse one of 2^32 - 1 elements.
+    let huge = js_sys::Array::new_with_length(u32::MAX);
+    let e = api::welch_js(huge.into(), js(r#"{"sampleRateHz":100}"#)).unwrap_err();
+    assert_eq!(
+        field_and_kind(e).1,
+        "tooLarge",
+        "the 2^26-sample limit, before any copy"
+    );
+    // A typed array on a detached buffer reads as empty: too short, not a TypeError.
+    let detached = js_sys::Float32Array::new_with_length(8);
+    let buffer = detached.buffer();
+    let options = js_sys::Object::new();
+    js_sys::Reflect::set(&options, &"transfer".into(), &js_sys::Array::of1(&buffer)).unwrap();
+    js_sys::Function::new_with_args("b, o", "structuredClone(b, o)")
+        .call2(&JsValue::NULL, &buffer, &options)
+        .unwrap();
+    assert_eq!(detached.length(), 0, "the buffer is detached");
+    let (field, kind, message) =
+        field_and_kind(api::welch_js(detached.into(), js(r#"{"sampleRateHz":100}"#)).unwrap_err());
+    assert_eq!(
+        (field.as_str(), kind.as_str()),
+        ("signal", "invalid"),
+        "{message}"
+    );
 }

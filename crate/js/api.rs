@@ -42,17 +42,29 @@ pub(crate) fn js_error(error: Error) -> JsValue {
 
 /// Reads a JS value into `T`, naming the path of a bad field under `what`.
 pub(crate) fn from_js<T: DeserializeOwned>(value: JsValue, what: &str) -> Result<T, Error> {
+    read(value, what, what)
+}
+
+/// Reads a spec (the one argument of `design`, `simulate`, …, the playground's `state`) into
+/// `T`: its fields are named from its root (`family`, `modes[0].damping`), the value itself
+/// `root` (`spec: is missing`).
+pub(crate) fn from_js_root<T: DeserializeOwned>(value: JsValue, root: &str) -> Result<T, Error> {
+    read(value, "", root)
+}
+
+/// Reads `value`, naming a field inside it `prefix.path` and the value itself `root`.
+fn read<T: DeserializeOwned>(value: JsValue, prefix: &str, root: &str) -> Result<T, Error> {
     if value.is_undefined() || value.is_null() {
         return Err(Error::Parse {
-            field: what.to_string(),
+            field: root.to_string(),
             reason: "is missing".into(),
         });
     }
     super::jsde::deserialize(value).map_err(|(path, e)| {
         let field = match path.as_str() {
-            "." | "" | "?" => what.to_string(),
-            p if what.is_empty() => p.to_string(),
-            p => format!("{what}.{p}"),
+            "." | "" | "?" => root.to_string(),
+            p if prefix.is_empty() => p.to_string(),
+            p => format!("{prefix}.{p}"),
         };
         Error::Parse {
             field,
@@ -87,7 +99,7 @@ fn mode_from_js(value: JsValue, what: &str) -> Result<Mode, Error> {
 #[cfg(any(feature = "js-api", feature = "js-designer"))]
 #[wasm_bindgen]
 pub fn design(spec: JsValue) -> Result<JsValue, JsValue> {
-    let request: DesignRequest = from_js(spec, "").map_err(js_error)?;
+    let request: DesignRequest = from_js_root(spec, "spec").map_err(js_error)?;
     #[cfg(feature = "js-api")]
     let shaper = design::design(&request).map_err(js_error)?;
     // The page's design worker's module: the solved families alone (README, *Playground*).
@@ -122,9 +134,14 @@ pub fn sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue
 /// band around the mode where V ≤ vtol, width as a fraction of `frequencyHz`.
 #[cfg(feature = "js-api")]
 #[wasm_bindgen]
-pub fn insensitivity(shaper: JsValue, mode: JsValue, vtol: f64) -> Result<JsValue, JsValue> {
+pub fn insensitivity(
+    shaper: JsValue,
+    mode: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "number")] vtol: JsValue,
+) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
     let mode = mode_from_js(mode, "mode").map_err(js_error)?;
+    let vtol = super::args::number(&vtol, "vtol").map_err(js_error)?;
     let band = vibration::insensitivity(&shaper, &mode, vtol).map_err(js_error)?;
     to_js(&band)
 }
@@ -180,10 +197,11 @@ pub fn damping_sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue,
 pub fn damping_insensitivity(
     shaper: JsValue,
     mode: JsValue,
-    vtol: f64,
+    #[wasm_bindgen(unchecked_param_type = "number")] vtol: JsValue,
 ) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
     let mode = mode_from_js(mode, "mode").map_err(js_error)?;
+    let vtol = super::args::number(&vtol, "vtol").map_err(js_error)?;
     let band = vibration::damping_insensitivity(&shaper, &mode, vtol).map_err(js_error)?;
     to_js(&band)
 }
@@ -195,8 +213,13 @@ pub fn damping_insensitivity(
 /// parameters.
 #[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = robustnessTable)]
-pub fn robustness_table(mode: JsValue, vtol: f64, specs: JsValue) -> Result<JsValue, JsValue> {
+pub fn robustness_table(
+    mode: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "number")] vtol: JsValue,
+    specs: JsValue,
+) -> Result<JsValue, JsValue> {
     let mode = mode_from_js(mode, "mode").map_err(js_error)?;
+    let vtol = super::args::number(&vtol, "vtol").map_err(js_error)?;
     let specs: Vec<ShaperSpec> = if specs.is_undefined() || specs.is_null() {
         crate::robustness::parameterless_specs()
     } else {
@@ -312,7 +335,7 @@ pub fn ramp_delay(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue> {
 #[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = sampledReport)]
 pub fn sampled_report(spec: JsValue) -> Result<JsValue, JsValue> {
-    let request: DesignRequest = from_js(spec, "").map_err(js_error)?;
+    let request: DesignRequest = from_js_root(spec, "spec").map_err(js_error)?;
     let ShaperSpec::Sampled(sampled) = &request.shaper else {
         return Err(js_error(Error::invalid(
             "family",
@@ -350,7 +373,7 @@ pub fn quantize(shaper: JsValue, mode: JsValue, options: JsValue) -> Result<JsVa
 #[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn simulate(spec: JsValue) -> Result<JsValue, JsValue> {
-    let spec: crate::scenario::SimulationSpec = from_js(spec, "").map_err(js_error)?;
+    let spec: crate::scenario::SimulationSpec = from_js_root(spec, "spec").map_err(js_error)?;
     let result = crate::scenario::run(&spec).map_err(js_error)?;
     to_js(&result)
 }
@@ -361,7 +384,7 @@ pub fn simulate(spec: JsValue) -> Result<JsValue, JsValue> {
 #[cfg(feature = "js-api")]
 #[wasm_bindgen]
 pub fn spectrum(spec: JsValue) -> Result<JsValue, JsValue> {
-    let spec: crate::scenario::SpectrumSpec = from_js(spec, "").map_err(js_error)?;
+    let spec: crate::scenario::SpectrumSpec = from_js_root(spec, "spec").map_err(js_error)?;
     let result = crate::scenario::spectrum_for(&spec).map_err(js_error)?;
     to_js(&result)
 }

@@ -17,6 +17,20 @@ use wasm_bindgen::{JsCast, JsValue};
 
 type Result<T> = std::result::Result<T, Error>;
 
+#[wasm_bindgen::prelude::wasm_bindgen]
+extern "C" {
+    /// `Object.entries(object)`, its exception caught: a getter or a Proxy trap may throw
+    /// (issue 21), which is then an error of the value, not an exception through the module.
+    #[wasm_bindgen(catch, js_namespace = Object, js_name = entries)]
+    fn try_entries(object: &JsValue) -> std::result::Result<Array, JsValue>;
+}
+
+/// [`try_entries`], a throw reported as an error of the value.
+fn entries_of(object: &JsValue) -> Result<Array> {
+    try_entries(object)
+        .map_err(|_| de::Error::custom("could not be read (a getter or a Proxy trap threw)"))
+}
+
 /// One step of the path: an element index, a map key (or enum variant), or a non-string key.
 enum Segment {
     Index(usize),
@@ -447,25 +461,33 @@ impl De {
         Some(v.to_vec())
     }
 
+    /// The error for a value of the wrong type. Unlike serde-wasm-bindgen, which formats
+    /// anything else with `{:?}` (the whole of an array: seconds for a sparse
+    /// `new Array(2 ** 27)`) and copies binary data to say "byte array", this names what the
+    /// value is ([`super::args::describe`]) and quotes at most 40 characters of a string, so
+    /// that the error costs the same whatever was passed (issue 21).
     #[cold]
     fn invalid_type_(&self, visitor: &dyn de::Expected) -> Error {
-        let string;
-        let bytes;
+        let string: String;
         let unexpected = if self.is_nullish() {
             de::Unexpected::Unit
         } else if let Some(v) = self.value.as_bool() {
             de::Unexpected::Bool(v)
         } else if let Some(v) = self.value.as_f64() {
             de::Unexpected::Float(v)
-        } else if let Some(v) = self.value.as_string() {
-            string = v;
+        } else if let Some(v) = self.value.dyn_ref::<JsString>() {
+            string = if v.length() > 40 {
+                format!("{}…", String::from(v.slice(0, 40)))
+            } else {
+                String::from(v)
+            };
             de::Unexpected::Str(&string)
-        } else if let Some(v) = self.as_bytes() {
-            bytes = v;
-            de::Unexpected::Bytes(&bytes)
+        } else if self.value.is_instance_of::<Uint8Array>()
+            || self.value.is_instance_of::<ArrayBuffer>()
+        {
+            de::Unexpected::Other("byte array")
         } else {
-            string = format!("{:?}", self.value);
-            de::Unexpected::Other(&string)
+            de::Unexpected::Other(super::args::describe(&self.value))
         };
         de::Error::invalid_type(unexpected, visitor)
     }
@@ -544,7 +566,7 @@ impl De {
             Some(iter) => visitor.visit_map(MapAccess::new(MapSource::Iter(iter))),
             None => {
                 if self.value.is_object() {
-                    let entries = Object::entries(self.value.unchecked_ref());
+                    let entries = entries_of(&self.value)?;
                     let len = entries.length();
                     visitor.visit_map(MapAccess::new(MapSource::Entries {
                         entries,
@@ -621,8 +643,12 @@ impl De {
                 payload: JsValue::UNDEFINED,
                 tag_field: None,
             }
-        } else if self.value.is_object() {
-            let entries = Object::entries(self.value.unchecked_ref());
+        } else if self.value.is_object()
+            // Not `Object.entries` of a typed array: one entry per element, 2^26 of them for
+            // a long signal (issue 21's fuzz: gigabytes for `firmware: new Float32Array(…)`).
+            && !ArrayBuffer::is_view(&self.value)
+        {
+            let entries = entries_of(&self.value)?;
             if entries.length() != 1 {
                 return Err(de::Error::invalid_length(entries.length() as _, &"1"));
             }

@@ -9,6 +9,7 @@
 #![cfg_attr(not(feature = "js-api"), allow(dead_code, unused_imports))]
 
 use super::api::{from_js, js_error, set, to_js};
+use super::args::{self, f64_vec};
 use super::canvas::Canvas;
 use crate::chart::{self, ChartStyle};
 use crate::error::Error;
@@ -55,36 +56,6 @@ fn options<T: serde::de::DeserializeOwned + Default>(
     } else {
         from_js(value, what)
     }
-}
-
-/// A `Float64Array` or an array of numbers as a `Vec<f64>`, naming `field[i]` otherwise.
-fn f64_vec(value: &JsValue, field: &str) -> Result<Vec<f64>, Error> {
-    if let Some(a) = value.dyn_ref::<js_sys::Float64Array>() {
-        return Ok(a.to_vec());
-    }
-    if let Some(a) = value.dyn_ref::<js_sys::Float32Array>() {
-        return Ok(a.to_vec().into_iter().map(f64::from).collect());
-    }
-    if let Some(a) = value.dyn_ref::<js_sys::Array>() {
-        return a
-            .iter()
-            .enumerate()
-            .map(|(i, v)| {
-                v.as_f64().ok_or_else(|| Error::Parse {
-                    field: format!("{field}[{i}]"),
-                    reason: "must be a number".into(),
-                })
-            })
-            .collect();
-    }
-    Err(Error::Parse {
-        field: field.to_string(),
-        reason: if value.is_undefined() || value.is_null() {
-            "is missing".into()
-        } else {
-            "must be a Float64Array or an array of numbers".into()
-        },
-    })
 }
 
 fn get(object: &JsValue, key: &str) -> JsValue {
@@ -231,9 +202,13 @@ fn psd_to_js(psd: &Psd) -> Result<JsValue, JsValue> {
 /// }`. Errors carry `line`, `column`, `columnName` and `file` (the `fileName` option).
 #[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = parseRecording)]
-pub fn parse_recording(text: &str, options: JsValue) -> Result<JsValue, JsValue> {
+pub fn parse_recording(
+    #[wasm_bindgen(unchecked_param_type = "string")] text: JsValue,
+    options: JsValue,
+) -> Result<JsValue, JsValue> {
+    let text = args::string(&text, "text").map_err(js_error)?;
     let options: RecordingOptions = self::options(options, "options").map_err(js_error)?;
-    let parsed = recording::parse_file(text, &options).map_err(recording_error)?;
+    let parsed = recording::parse_file(&text, &options).map_err(recording_error)?;
     parsed_to_js(&parsed)
 }
 
@@ -259,9 +234,13 @@ impl JsRecordingParser {
     }
 
     /// Reads a chunk of text; throws at the first bad line (and on every later call).
-    pub fn push(&mut self, chunk: &str) -> Result<(), JsValue> {
+    pub fn push(
+        &mut self,
+        #[wasm_bindgen(unchecked_param_type = "string")] chunk: JsValue,
+    ) -> Result<(), JsValue> {
+        let chunk = args::string(&chunk, "chunk").map_err(js_error)?;
         match &mut self.inner {
-            Some(p) => p.push(chunk).map_err(recording_error),
+            Some(p) => p.push(&chunk).map_err(recording_error),
             None => Err(js_error(Error::invalid(
                 "recording",
                 "finish() was already called",
@@ -404,98 +383,99 @@ mod serde_json_like {
 #[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = identifyModes)]
 pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+    if !(options.is_undefined() || options.is_null() || options.is_object()) {
+        return Err(js_error(Error::Parse {
+            field: "options".into(),
+            reason: format!("must be an object, got {}", args::describe(&options)),
+        }));
+    }
     let is_spectrum = recording.is_object()
         && !get(&recording, "frequencyHz").is_undefined()
         && !get(&recording, "psd").is_undefined();
     if is_spectrum {
         let spectrum = spectrum_from_js(&recording).map_err(js_error)?;
-        let opts: IdentifyOptions = {
-            let copy = js_sys::Object::new();
-            if options.is_object() {
-                let _ = js_sys::Object::assign(&copy, options.unchecked_ref());
-                let _ = js_sys::Reflect::delete_property(&copy, &"channel".into());
-            }
-            from_js(copy.into(), "options").map_err(js_error)?
-        };
+        let opts = identify_options(&options).map_err(js_error)?;
         let id = identify_spectrum(&spectrum, &opts).map_err(js_error)?;
-        let out = js_sys::Object::new();
-        set(&out, "channel", &get(&recording, "channel"))?;
-        set(&out, "modes", &to_js(&id.modes)?)?;
-        set(&out, "spectrum", &psd_to_js(&id.spectrum)?)?;
-        set(
-            &out,
-            "detectionSegmentLength",
-            &(id.detection_segment_length as f64).into(),
-        )?;
-        set(&out, "bandHz", &to_js(&id.band_hz)?)?;
-        set(&out, "freeDecay", &JsValue::NULL)?;
-        return Ok(out.into());
+        return identification_to_js(&id, get(&recording, "channel"), JsValue::NULL);
     }
-    let is_signal = recording.is_instance_of::<js_sys::Float64Array>()
-        || recording.is_instance_of::<js_sys::Float32Array>()
-        || js_sys::Array::is_array(&recording);
     let choice: ChannelChoice = if options.is_object() {
         from_js(options.clone(), "options").map_err(js_error)?
     } else {
         ChannelChoice::default()
     };
-    let mut opts: IdentifyOptions = {
-        // `channel` is not an IdentifyOptions field: read the others from a copy without it.
-        let copy = js_sys::Object::new();
-        if options.is_object() {
-            let _ = js_sys::Object::assign(&copy, options.unchecked_ref());
-            let _ = js_sys::Reflect::delete_property(&copy, &"channel".into());
-        }
-        from_js(copy.into(), "options").map_err(js_error)?
-    };
-    let (signal, name) = if is_signal {
-        (
-            f64_vec(&recording, "signal").map_err(js_error)?,
-            JsValue::NULL,
-        )
+    let mut opts = identify_options(&options).map_err(js_error)?;
+    let (signal, name) = signal_to_identify(&recording, &choice, &mut opts).map_err(js_error)?;
+    let id = identify(&signal, &opts).map_err(js_error)?;
+    let free_decay = to_js(&id.free_decay)?;
+    identification_to_js(&id, name, free_decay)
+}
+
+/// `identifyModes`' options without `channel` (not an [`IdentifyOptions`] field: the others are
+/// read from a copy without it).
+fn identify_options(options: &JsValue) -> Result<IdentifyOptions, Error> {
+    let copy = if options.is_object() {
+        args::copy_object(options, "options")?
     } else {
-        let channels = get(&recording, "channels");
-        let channels: js_sys::Array = channels.dyn_into().map_err(|_| {
-            js_error(Error::Parse {
+        js_sys::Object::new()
+    };
+    let _ = js_sys::Reflect::delete_property(&copy, &"channel".into());
+    from_js(copy.into(), "options")
+}
+
+/// The samples `identifyModes` reads from `recording` — a signal, or the chosen channel of
+/// what `parseRecording` returns (whose `sampleRateHz` then fills in a missing
+/// `options.sampleRateHz`) — and the channel's name (`null` for a signal).
+fn signal_to_identify(
+    recording: &JsValue,
+    choice: &ChannelChoice,
+    opts: &mut IdentifyOptions,
+) -> Result<(Vec<f64>, JsValue), Error> {
+    let is_signal = recording.is_instance_of::<js_sys::Float64Array>()
+        || recording.is_instance_of::<js_sys::Float32Array>()
+        || js_sys::Array::is_array(recording);
+    if is_signal {
+        return Ok((f64_vec(recording, "signal")?, JsValue::NULL));
+    }
+    let channels: js_sys::Array =
+        get(recording, "channels")
+            .dyn_into()
+            .map_err(|_| Error::Parse {
                 field: "recording.channels".into(),
                 reason: "is missing: pass what parseRecording returns, or a signal".into(),
-            })
-        })?;
-        let index = match &choice.channel {
-            None => 0,
-            Some(serde_json_like::ChannelKey::Index(i)) => *i,
-            Some(serde_json_like::ChannelKey::Name(n)) => channels
-                .iter()
-                .position(|c| get(&c, "name").as_string().as_deref() == Some(n.as_str()))
-                .ok_or_else(|| {
-                    js_error(Error::invalid(
-                        "options.channel",
-                        format!("no channel named `{n}`"),
-                    ))
-                })?,
-        };
-        if index >= channels.length() as usize {
-            return Err(js_error(Error::invalid(
-                "options.channel",
-                format!("the recording has {} channels", channels.length()),
-            )));
-        }
-        let c = channels.get(index as u32);
-        if opts.sample_rate_hz.is_nan() {
-            opts.sample_rate_hz = get(&recording, "sampleRateHz").as_f64().unwrap_or(f64::NAN);
-        }
-        (
-            f64_vec(
-                &get(&c, "values"),
-                &format!("recording.channels[{index}].values"),
-            )
-            .map_err(js_error)?,
-            get(&c, "name"),
-        )
+            })?;
+    let index = match &choice.channel {
+        None => 0,
+        Some(serde_json_like::ChannelKey::Index(i)) => *i,
+        Some(serde_json_like::ChannelKey::Name(n)) => channels
+            .iter()
+            .position(|c| get(&c, "name").as_string().as_deref() == Some(n.as_str()))
+            .ok_or_else(|| Error::invalid("options.channel", format!("no channel named `{n}`")))?,
     };
-    let id = identify(&signal, &opts).map_err(js_error)?;
+    if index >= channels.length() as usize {
+        return Err(Error::invalid(
+            "options.channel",
+            format!("the recording has {} channels", channels.length()),
+        ));
+    }
+    let c = channels.get(index as u32);
+    if opts.sample_rate_hz.is_nan() {
+        opts.sample_rate_hz = get(recording, "sampleRateHz").as_f64().unwrap_or(f64::NAN);
+    }
+    let values = f64_vec(
+        &get(&c, "values"),
+        &format!("recording.channels[{index}].values"),
+    )?;
+    Ok((values, get(&c, "name")))
+}
+
+/// What `identifyModes` returns for `id`.
+fn identification_to_js(
+    id: &crate::measure::identify::Identification,
+    channel: JsValue,
+    free_decay: JsValue,
+) -> Result<JsValue, JsValue> {
     let out = js_sys::Object::new();
-    set(&out, "channel", &name)?;
+    set(&out, "channel", &channel)?;
     set(&out, "modes", &to_js(&id.modes)?)?;
     set(&out, "spectrum", &psd_to_js(&id.spectrum)?)?;
     set(
@@ -504,7 +484,7 @@ pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, J
         &(id.detection_segment_length as f64).into(),
     )?;
     set(&out, "bandHz", &to_js(&id.band_hz)?)?;
-    set(&out, "freeDecay", &to_js(&id.free_decay)?)?;
+    set(&out, "freeDecay", &free_decay)?;
     Ok(out.into())
 }
 
@@ -612,10 +592,11 @@ struct DrawOptions {
 #[cfg(feature = "js-playground")]
 #[wasm_bindgen(js_name = drawSpectrum)]
 pub fn draw_spectrum(
-    canvas: HtmlCanvasElement,
+    #[wasm_bindgen(unchecked_param_type = "HTMLCanvasElement")] canvas: JsValue,
     spectrum: JsValue,
     options: JsValue,
 ) -> Result<(), JsValue> {
+    let canvas = args::canvas(canvas, "canvas").map_err(js_error)?;
     let f = f64_vec(&get(&spectrum, "frequencyHz"), "spectrum.frequencyHz").map_err(js_error)?;
     let p = f64_vec(&get(&spectrum, "psd"), "spectrum.psd").map_err(js_error)?;
     let o: DrawOptions = self::options(options, "options").map_err(js_error)?;
@@ -689,10 +670,11 @@ struct KlipperDrawOptions {
 #[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = drawKlipperChart)]
 pub fn draw_klipper_chart(
-    canvas: HtmlCanvasElement,
+    #[wasm_bindgen(unchecked_param_type = "HTMLCanvasElement")] canvas: JsValue,
     data: JsValue,
     options: JsValue,
 ) -> Result<(), JsValue> {
+    let canvas = args::canvas(canvas, "canvas").map_err(js_error)?;
     let vec = |key: &str| f64_vec(&get(&data, key), key).map_err(js_error);
     let optional = |key: &str| -> Result<Option<Vec<f64>>, JsValue> {
         let v = get(&data, key);

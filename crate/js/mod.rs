@@ -6,6 +6,8 @@
 //! - [`measure`]: its measured-data part (`parseRecording`, `welch`, `identifyModes`,
 //!   `recommendShaper`, `drawSpectrum`, …);
 //! - [`playground`]: the page's frame, `renderPlayground`, in its stages;
+//! - `args`: the exports' arguments checked as what they must be (a string, a number, a
+//!   canvas, an array of numbers), whatever JS passes;
 //! - `jsde`: the reader of JS values (serde, with the path of the failing field);
 //! - `canvas`: the page's drawing backend (plotters on a 2-D canvas context).
 //!
@@ -13,6 +15,7 @@
 //! the JS `design`.
 
 pub mod api;
+pub(crate) mod args;
 pub(crate) mod canvas;
 pub(crate) mod jsde;
 pub mod measure;

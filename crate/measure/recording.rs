@@ -288,6 +288,48 @@ pub struct RecordingParser {
     header_line_seen: usize,
 }
 
+/// The value in column `column` (1-based, named `name`) of line `n`: present, a number,
+/// finite.
+fn value_of(n: usize, column: usize, name: &str, field: &str) -> Result<f64, RecordingError> {
+    if field.is_empty() {
+        return Err(RecordingError::field(n, column, name, "the value is empty"));
+    }
+    let value: f64 = field.parse().map_err(|_| {
+        RecordingError::field(n, column, name, format!("`{field}` is not a number"))
+    })?;
+    if !value.is_finite() {
+        return Err(RecordingError::field(
+            n,
+            column,
+            name,
+            format!("`{field}` is not a finite number"),
+        ));
+    }
+    Ok(value)
+}
+
+/// Why a header line without a time column is no header: a row of numbers, a `timeColumn`
+/// option the header does not name, or no column of a time name.
+fn no_time_column(names: &[String], wanted: Option<&str>) -> String {
+    if names.iter().all(|s| s.parse::<f64>().is_ok()) {
+        return "no header: the first line must name the columns, one of them the time \
+                (e.g. `time,accel_x,accel_y,accel_z`)"
+            .to_string();
+    }
+    let listed = names
+        .iter()
+        .map(|s| format!("`{s}`"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    match wanted {
+        Some(w) => format!("no column named `{w}` (the header has {listed})"),
+        None => format!(
+            "no time column in the header ({listed}); name it `time` or give \
+             its name as the timeColumn option"
+        ),
+    }
+}
+
 fn split(line: &str, sep: Separator) -> Vec<&str> {
     match sep {
         Separator::Char(c) => line.split(c).map(str::trim).collect(),
@@ -391,12 +433,20 @@ impl RecordingParser {
         if text.is_empty() {
             return Ok(());
         }
-        let Some(header) = &self.header else {
+        if self.header.is_none() {
             return self.header_line(text);
-        };
+        }
         if text.starts_with('#') {
             return Ok(());
         }
+        self.row(n, text)
+    }
+
+    /// A data row (line `n`, trimmed, after the header): its values checked and stored.
+    fn row(&mut self, n: usize, text: &str) -> Result<(), RecordingError> {
+        let Some(header) = &self.header else {
+            return Ok(());
+        };
         let fields = split(text, header.separator);
         let count = if fields.len() == header.names.len() + 1 && fields.last() == Some(&"") {
             header.names.len()
@@ -434,20 +484,7 @@ impl RecordingParser {
                 }
                 continue;
             }
-            if field.is_empty() {
-                return Err(RecordingError::field(n, j + 1, name, "the value is empty"));
-            }
-            let value: f64 = field.parse().map_err(|_| {
-                RecordingError::field(n, j + 1, name, format!("`{field}` is not a number"))
-            })?;
-            if !value.is_finite() {
-                return Err(RecordingError::field(
-                    n,
-                    j + 1,
-                    name,
-                    format!("`{field}` is not a finite number"),
-                ));
-            }
+            let value = value_of(n, j + 1, name, field)?;
             if let Some(layout) = &header.spectrum {
                 if j == 0 {
                     if let Some(&prev) = self.times.last() {
@@ -545,25 +582,7 @@ impl RecordingParser {
             if commented {
                 return Ok(()); // a comment before the header
             }
-            let numeric = names.iter().all(|s| s.parse::<f64>().is_ok());
-            let reason = if numeric {
-                "no header: the first line must name the columns, one of them the time \
-                 (e.g. `time,accel_x,accel_y,accel_z`)"
-                    .to_string()
-            } else {
-                let listed = names
-                    .iter()
-                    .map(|s| format!("`{s}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ");
-                match wanted {
-                    Some(w) => format!("no column named `{w}` (the header has {listed})"),
-                    None => format!(
-                        "no time column in the header ({listed}); name it `time` or give \
-                         its name as the timeColumn option"
-                    ),
-                }
-            };
+            let reason = no_time_column(&names, wanted);
             return Err(RecordingError::at(n, reason));
         };
         if names.len() < 2 {

@@ -114,7 +114,6 @@ fn calls() -> Vec<(&'static str, Call, Vec<JsValue>)> {
     ))
     .expect("the good design works");
     let mode = || js(r#"{"frequencyHz":2,"damping":0.05}"#);
-    let f64_of = |v: &JsValue| v.as_f64().unwrap_or(f64::NAN);
     vec![
         (
             "design",
@@ -140,9 +139,7 @@ fn calls() -> Vec<(&'static str, Call, Vec<JsValue>)> {
         ),
         (
             "insensitivity",
-            Box::new(move |a: &[JsValue]| {
-                wasm::insensitivity(a[0].clone(), a[1].clone(), f64_of(&a[2]))
-            }),
+            Box::new(|a: &[JsValue]| wasm::insensitivity(a[0].clone(), a[1].clone(), a[2].clone())),
             vec![shaper.clone(), mode(), JsValue::from(0.05)],
         ),
         (
@@ -166,14 +163,14 @@ fn calls() -> Vec<(&'static str, Call, Vec<JsValue>)> {
         (
             "dampingInsensitivity",
             Box::new(move |a: &[JsValue]| {
-                wasm::damping_insensitivity(a[0].clone(), a[1].clone(), f64_of(&a[2]))
+                wasm::damping_insensitivity(a[0].clone(), a[1].clone(), a[2].clone())
             }),
             vec![shaper.clone(), mode(), JsValue::from(0.05)],
         ),
         (
             "robustnessTable",
             Box::new(move |a: &[JsValue]| {
-                wasm::robustness_table(a[0].clone(), f64_of(&a[1]), a[2].clone())
+                wasm::robustness_table(a[0].clone(), a[1].clone(), a[2].clone())
             }),
             vec![
                 mode(),

@@ -16,7 +16,7 @@ use serde::Deserialize;
 use wasm_bindgen::{JsCast, JsValue};
 use web_sys::HtmlCanvasElement;
 
-use super::super::api::from_js;
+use super::super::api::from_js_root;
 
 /// Most shapers the playground compares at once.
 const MAX_COMPARED: usize = 4;
@@ -200,7 +200,7 @@ pub(super) struct Frame {
 impl Frame {
     /// Reads and checks `state` and collects `canvases`. Errors name the field.
     pub(super) fn parse(state: JsValue, canvases: &JsValue) -> Result<Frame, Error> {
-        let state: PlaygroundState = from_js(state, "")?;
+        let state: PlaygroundState = from_js_root(state, "state")?;
         let modes = Mode::list(&state.modes)?;
         let specs = compared(state.shapers, state.shaper)?;
         let designed = designed(&state.designed, specs.len())?;
