@@ -72,18 +72,7 @@ fn recording_to_js(rec: &Recording) -> Result<JsValue, JsValue> {
     set(&out, "rows", &(rec.rows as f64).into())?;
     set(&out, "resampled", &rec.resampled.into())?;
     set(&out, "timing", &to_js(&rec.timing)?)?;
-    let channels = js_sys::Array::new();
-    for c in &rec.channels {
-        let ch = js_sys::Object::new();
-        set(&ch, "name", &c.name.clone().into())?;
-        set(
-            &ch,
-            "values",
-            &js_sys::Float64Array::from(c.values.as_slice()),
-        )?;
-        channels.push(&ch);
-    }
-    set(&out, "channels", &channels)?;
+    set(&out, "channels", &channels_to_js(&rec.channels)?.into())?;
     Ok(out.into())
 }
 
@@ -379,7 +368,9 @@ mod serde_json_like {
 /// maxModes, minFrequencyHz, maxFrequencyHz, minProminenceDb, segmentLength, freeDecay }`.
 /// → `{ channel, modes: [{ frequencyHz, damping, frequencyUncertaintyHz, dampingUncertainty,
 /// method, peakFrequencyHz, peakPsd, prominenceDb, estimates: [...] }], spectrum: { frequencyHz,
-/// psd, … }, detectionSegmentLength, bandHz, freeDecay: { startS, endS, levelDb } | null }`.
+/// psd, … }, detectionSegmentLength, bandHz, freeDecay: { startS, endS, levelDb } | null,
+/// sweep: { bandHz, rateHzPerS } | null }` (`sweep`: the linear sweep read from a raw recording,
+/// whose modes were then fitted on its whole-record periodogram; `null` otherwise).
 #[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = identifyModes)]
 pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
@@ -485,6 +476,11 @@ fn identification_to_js(
     )?;
     set(&out, "bandHz", &to_js(&id.band_hz)?)?;
     set(&out, "freeDecay", &free_decay)?;
+    let sweep = match &id.sweep {
+        Some(sweep) => to_js(sweep)?,
+        None => JsValue::NULL,
+    };
+    set(&out, "sweep", &sweep)?;
     Ok(out.into())
 }
 

@@ -85,6 +85,10 @@ test('a raw Klipper recording: the axis chart, Klipper\'s table and the config',
   // The raw recording's modes are identified, for the playground.
   await page.waitForSelector('#measure-modes tbody tr[data-mode]');
   assert.equal(await page.isDisabled('#measure-accept'), false);
+  // The sweep read from the data (the generator's: 38 -> 56 Hz at 2 Hz/s) is said.
+  const said = (await page.textContent('#measure-status')).match(/a sweep of ([\d.]+)–([\d.]+) Hz at ([\d.]+) Hz\/s/);
+  assert.ok(said, await page.textContent('#measure-status'));
+  assert.ok(Math.abs(Number(said[3]) - 2) < 0.1 && Number(said[1]) < 47.3 && Number(said[2]) > 47.3, said[0]);
   await page.locator('#measure').screenshot({ path: `${SCREENSHOTS}measure-klipper-raw.png` });
   assertKlipperPick(rows, 'raw_data_x_single47z08.csv');
   assert.deepEqual(problems, []);
