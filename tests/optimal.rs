@@ -316,6 +316,22 @@ fn recommend_criterion_optimal_ranks_the_optimised_shaper_first() {
         "{} vs {expected}",
         pick.label
     );
+    // Each row says its kind; a family row carries the mode a config writes (shaper_freq at
+    // damping_ratio, Klipper's pick at Klipper's 0.1), a custom row none.
+    assert_eq!(pick.kind, Some("klipper"));
+    assert_eq!(r.ranked[0].kind, Some("custom"));
+    assert!(r.ranked[0].modes.is_empty());
+    assert_eq!(pick.modes.len(), 1);
+    assert!((pick.modes[0].frequency_hz - best.pick.freq).abs() < 1e-9);
+    assert!((pick.modes[0].damping - fit.damping_ratio).abs() < 1e-12);
+    let mainline = r
+        .ranked
+        .iter()
+        .find(|c| c.kind == Some("mainline"))
+        .unwrap();
+    assert!(mainline
+        .label
+        .contains(&format!("{:.2} Hz", mainline.modes[0].frequency_hz)));
     let score = |i: usize| r.ranked[i].klipper_score.unwrap();
     assert!(score(0) <= pick.klipper_score.unwrap());
     assert!(r.note.as_deref().is_some_and(|n| !n.is_empty()));

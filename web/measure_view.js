@@ -40,6 +40,8 @@ const pct = (x) => (Number.isFinite(x) ? `${fmt(100 * x, 3)} %` : '—');
 const fixed = (x, d) => (Number.isFinite(x) ? x.toFixed(d) : '—');
 /** Klipper's max_accel as it prints it: round(max_accel / 100) · 100. */
 const accel = (x) => (Number.isFinite(x) ? String(Math.round(x / 100) * 100) : '—');
+/** The optimised table's row kinds (recommendShaper's `kind` with criterion 'optimal'). */
+const KIND = { klipper: "Klipper's pick", mainline: 'best mainline', custom: 'custom' };
 const METHOD = { halfPower: 'half-power', spectrumFit: 'spectrum fit', freeDecay: 'free-decay fit' };
 const AXIS_NAME = (a) => (/^[xyz]$/.test(a) ? `Axis ${a.toUpperCase()}` : a);
 
@@ -200,7 +202,7 @@ function rowsTable(cls, rows, selected, caption, withLabel) {
     },
     el('td', {}, r.color ? el('span', { class: 'swatch line', style: `border-color: ${r.color}` }) : ''),
     el('td', { class: 'name' }, r.label ?? r.name),
-    ...(withLabel ? [el('td', {}, r.kind ?? '')] : []),
+    ...(withLabel ? [el('td', {}, KIND[r.kind] ?? r.kind ?? '')] : []),
     el('td', { class: 'num' }, fixed(r.freq, 1)),
     el('td', { class: 'num' }, Number.isFinite(r.damping) ? fmt(r.damping, 3) : '—'),
     el('td', { class: 'num' }, Number.isFinite(r.vibrations) ? (100 * r.vibrations).toFixed(1) : '—'),

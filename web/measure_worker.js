@@ -202,7 +202,7 @@ function row(c, f) {
     name: c.name ?? c.family,
     kind: c.kind ?? c.firmware ?? null,
     freq: p.freq ?? p.frequencyHz ?? c.spec?.frequencyHz ?? c.modes?.[0]?.frequencyHz ?? NaN,
-    damping: p.dampingRatio ?? c.dampingRatio ?? c.damping ?? c.spec?.damping ?? NaN,
+    damping: p.dampingRatio ?? c.dampingRatio ?? c.damping ?? c.spec?.damping ?? c.modes?.[0]?.damping ?? NaN,
     vibrations: p.vibrations ?? p.vibrs ?? c.remainingVibration,
     smoothing: p.smoothing,
     maxAccel: p.maxAccel,

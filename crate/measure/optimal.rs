@@ -1216,7 +1216,15 @@ pub fn recommend_optimal(
                     impulses: row.shaper.impulses.clone(),
                     normalize: false,
                 },
-                modes: Vec::new(),
+                // A family row is designed for its `shaper_freq` at its `damping_ratio`, as the
+                // `klipper` criterion's rows are; a custom sequence for no single mode.
+                modes: match (row.shaper_freq_hz, row.damping_ratio) {
+                    (Some(frequency_hz), Some(damping)) => vec![crate::mode::ModeSpec {
+                        frequency_hz,
+                        damping,
+                    }],
+                    _ => Vec::new(),
+                },
                 duration_s: row.shaper.duration,
                 shaper: row.shaper.clone(),
                 remaining_vibration: row.klipper.vibrations,
@@ -1225,6 +1233,7 @@ pub fn recommend_optimal(
                 max_accel: Some(row.klipper.max_accel).filter(|a| a.is_finite()),
                 klipper_score: Some(row.klipper.score),
                 acceptable: row.klipper.vibrations <= vmax,
+                kind: Some(row.kind),
             }
         })
         .collect();

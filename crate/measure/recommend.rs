@@ -260,6 +260,10 @@ pub struct Candidate {
     pub klipper_score: Option<f64>,
     /// Whether `remainingVibration ≤ maxRemainingVibration`.
     pub acceptable: bool,
+    /// With `criterion: "optimal"`: the row's kind (`klipper`: Klipper's own pick, `mainline`:
+    /// the best mainline-Klipper shaper, `custom`); absent for the other criteria.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kind: Option<&'static str>,
 }
 
 /// A candidate left out, and why.
@@ -643,6 +647,7 @@ fn score_candidate(
         max_accel,
         klipper_score: smooth.map(|s| klipper::fit::score(s, worst)),
         acceptable: worst <= sc.vmax,
+        kind: None,
     })
 }
 
@@ -744,6 +749,7 @@ fn klipper_recommendation(
             max_accel: Some(p.max_accel).filter(|a| a.is_finite()),
             klipper_score: Some(p.score),
             acceptable: p.vibrs <= vmax,
+            kind: None,
         });
     }
     // By score; `recommended` is Klipper's pick wherever it lands.

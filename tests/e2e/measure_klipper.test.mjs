@@ -89,6 +89,16 @@ test('a raw Klipper recording: the axis chart, Klipper\'s table and the config',
   const said = (await page.textContent('#measure-status')).match(/a sweep of ([\d.]+)–([\d.]+) Hz at ([\d.]+) Hz\/s/);
   assert.ok(said, await page.textContent('#measure-status'));
   assert.ok(Math.abs(Number(said[3]) - 2) < 0.1 && Number(said[1]) < 47.3 && Number(said[2]) > 47.3, said[0]);
+  // The optimised table: every family row says its kind, shaper_freq and damping_ratio (a
+  // config needs all three); Klipper's pick is the same as in Klipper's table.
+  const optimal = await page.$$eval('.measure-axis[data-axis="x"] table.optimal-table tbody tr', (trs) => trs.map((r) => [...r.cells].map((c) => c.textContent)));
+  assert.ok(optimal.length >= 2, JSON.stringify(optimal));
+  for (const cells of optimal.filter((c) => !c[2].startsWith('custom'))) {
+    assert.ok(cells[2] !== '' && Number.isFinite(Number(cells[3])) && Number.isFinite(Number(cells[4])), JSON.stringify(cells));
+  }
+  const pickRow = optimal.find((c) => c[2] === "Klipper's pick");
+  assert.ok(pickRow, JSON.stringify(optimal));
+  assert.equal(pickRow[3], rows.find((r) => r.best).shown);
   await page.locator('#measure').screenshot({ path: `${SCREENSHOTS}measure-klipper-raw.png` });
   assertKlipperPick(rows, 'raw_data_x_single47z08.csv');
   assert.deepEqual(problems, []);
