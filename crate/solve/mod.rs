@@ -564,13 +564,7 @@ fn shortest(norm: NormalizedProblem) -> Result<Design> {
 /// Where the grid solution itself exceeds a band between the samples (its maxima there).
 #[cfg(feature = "solver")]
 fn grid_violations(norm: &NormalizedProblem, grid: &GridSolution) -> Vec<NormalizedLimit> {
-    let raw: Vec<Impulse> = grid
-        .times
-        .iter()
-        .zip(&grid.amplitudes)
-        .map(|(&time, &amplitude)| Impulse { time, amplitude })
-        .collect();
-    scan::check(norm, &raw).violations
+    scan::check(norm, &grid.impulses()).violations
 }
 
 /// While the polish fails (impulses too close for the grid to resolve, a poor start), the
@@ -645,6 +639,17 @@ pub(crate) struct GridSolution {
     pub amplitudes: Vec<f64>,
     /// The duration (the last time).
     pub duration: f64,
+}
+
+impl GridSolution {
+    /// Every grid point as an impulse (zero amplitudes included).
+    pub(crate) fn impulses(&self) -> Vec<Impulse> {
+        self.times
+            .iter()
+            .zip(&self.amplitudes)
+            .map(|(&time, &amplitude)| Impulse { time, amplitude })
+            .collect()
+    }
 }
 
 /// Grid intervals for a duration `t` (normalized).

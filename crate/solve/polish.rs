@@ -685,12 +685,7 @@ fn freedom(norm: &NormalizedProblem, active: &Active) -> i64 {
 /// (same amplitude sum, mean time and spread).
 pub(crate) fn polish(norm: &NormalizedProblem, grid: &GridSolution) -> Option<Vec<Impulse>> {
     let found = clusters(grid);
-    let raw: Vec<Impulse> = grid
-        .times
-        .iter()
-        .zip(&grid.amplitudes)
-        .map(|(&time, &amplitude)| Impulse { time, amplitude })
-        .collect();
+    let raw = grid.impulses();
     let mut wide: Vec<usize> = (0..found.len())
         .filter(|&i| found[i].spacing > 0.0 && found[i].spread > 0.55 * found[i].spacing)
         .collect();
