@@ -9,7 +9,12 @@
 # `optimize_for_size` feature would save 7 KB more, but it formats floats (every tick label)
 # with Dragon4 only, not Grisu. Without that toolchain (setup could not install it), or with
 # STABLE=1, it is built by stable Rust.
+#
+# Usage: bash scripts/build.sh [--library | --check]
+#   --library  only the whole API's module, pkg/input_shaping* (for `npm run pack`);
+#   --check    builds nothing: says which modules are up to date (exit 1 if any is not).
 set -euo pipefail
+what=${1:-all}
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 [ -f "$HOME/.cargo/env" ] && . "$HOME/.cargo/env"
@@ -69,7 +74,6 @@ build_module() {
   echo "[build] $out/$name.js ($features): built by $how"
 }
 
-# Each module's wasm-opt runs in the background while the next one compiles.
 # shrink WASM [LEVEL]   (wasm-opt's -Oz, or -O2 for the speed-tuned module)
 shrink() {
   local wasm=$1 level=${2:-z}
@@ -79,24 +83,88 @@ shrink() {
   fi
 }
 
-rm -rf pkg
+# Only what its inputs changed is rebuilt (issue 21, item 6): a second `npm start` with nothing
+# changed takes seconds, not minutes. Each module's stamp, pkg/[page/].NAME.stamp, holds the hash
+# of everything its build reads (scripts/stamp.sh: crate/, Cargo.toml, Cargo.lock,
+# .cargo/config.toml, these scripts, the toolchain's `rustc -vV`, the wasm-bindgen and binaryen
+# versions, its features, opt-level and wasm-opt level, RUSTFLAGS) and the SHA-256 of its four
+# outputs. A module whose inputs hash the same and whose outputs are intact is kept; any other
+# is rebuilt (cargo, wasm-bindgen, wasm-opt), and its stamp is written only after wasm-opt has
+# finished, so an interrupted or failed build leaves no stamp and is redone. Contents are hashed,
+# not times: `touch` alone rebuilds nothing, an edit rebuilds every module. FORCE=1 rebuilds all.
+if [ "$use_nightly" = 1 ]; then rustc_version=$(rustup run "$nightly" rustc -vV); else rustc_version=$(rustc -vV); fi
+bindgen_version=$(wasm-bindgen --version)
+binaryen_version=none
+if [ -x node_modules/.bin/wasm-opt ]; then
+  binaryen_version=$(node -p 'require("./node_modules/binaryen/package.json").version')
+fi
+stamps=1 # 0 once a module fell back to stable Rust: nothing is stamped, the next build retries
+
+# module_key FEATURES OPT_LEVEL WASM_OPT_LEVEL
+module_key() {
+  bash scripts/stamp.sh --files crate Cargo.toml Cargo.lock .cargo/config.toml rust-toolchain \
+    rust-toolchain.toml scripts/build.sh scripts/stamp.sh scripts/nightly.sh -- \
+    "features=$1" "opt-level=$2" "wasm-opt=$3" "nightly=$use_nightly" "$rustc_version" \
+    "$bindgen_version" "binaryen=$binaryen_version"
+}
+# outputs OUT_DIR NAME: what wasm-bindgen writes (and wasm-opt rewrites)
+outputs() { printf '%s\n' "$1/$2.js" "$1/$2.d.ts" "$1/${2}_bg.wasm" "$1/${2}_bg.wasm.d.ts"; }
+# up_to_date KEY STAMP: the stamp's first line is KEY and its checksums match the outputs
+up_to_date() {
+  [ "${FORCE:-0}" != 1 ] && [ -f "$2" ] && [ "$(head -n 1 "$2")" = "$1" ] \
+    && tail -n +2 "$2" | sha256sum --check --status 2>/dev/null
+}
+# write_stamp KEY STAMP OUT_DIR NAME
+write_stamp() {
+  { echo "$1"; outputs "$3" "$4" | xargs sha256sum; } > "$2.tmp" && mv "$2.tmp" "$2"
+}
+
+# module FEATURES OUT_DIR NAME OPT_LEVEL WASM_OPT_LEVEL: builds it unless up to date; its
+# wasm-opt runs in the background while the next one compiles.
+module() {
+  local features=$1 out=$2 name=$3 opt=$4 level=$5 key stamp
+  stamp="$out/.$name.stamp"
+  key=$(module_key "$features" "$opt" "$level")
+  if up_to_date "$key" "$stamp"; then
+    echo "[build] $out/$name.js ($features): up to date, kept (FORCE=1 rebuilds)"
+    return
+  fi
+  if [ "$what" = --check ]; then
+    echo "[build] $out/$name.js ($features): to be rebuilt"
+    stale=$((stale + 1))
+    return
+  fi
+  rm -f "$stamp"
+  local before=$use_nightly
+  build_module "$features" "$out" "$name" "$opt"
+  [ "$use_nightly" = "$before" ] || stamps=0
+  local write=$stamps
+  { shrink "$out/${name}_bg.wasm" "$level" && if [ "$write" = 1 ]; then write_stamp "$key" "$stamp" "$out" "$name"; fi; } &
+  pids+=($!)
+}
+
+mkdir -p pkg/page
 pids=()
-build_module js-api pkg input_shaping
-shrink pkg/input_shaping_bg.wasm & pids+=($!)
-build_module js-playground pkg/page playground 2
-shrink pkg/page/playground_bg.wasm 2 & pids+=($!)
-build_module js-designer,solver pkg/page designer
-shrink pkg/page/designer_bg.wasm & pids+=($!)
-build_module js-recording pkg/page recording
-shrink pkg/page/recording_bg.wasm & pids+=($!)
-for pid in "${pids[@]}"; do wait "$pid"; done
-bash scripts/bundle.sh
+stale=0
+module js-api pkg input_shaping z z
+if [ "$what" != --library ]; then
+  module js-playground pkg/page playground 2 2
+  module js-designer,solver pkg/page designer z z
+  module js-recording pkg/page recording z z
+fi
+for pid in "${pids[@]+"${pids[@]}"}"; do wait "$pid"; done
+if [ "$what" = --check ]; then exit $((stale > 0)); fi
+if [ "$what" = --library ]; then modules=(pkg/input_shaping); bundles=(); else
+  bash scripts/bundle.sh
+  modules=(pkg/input_shaping pkg/page/playground pkg/page/designer pkg/page/recording)
+  bundles=(pkg/page/main.js pkg/page/measure_worker.js pkg/page/design_worker.js)
+fi
 
 gz() { gzip -9 -c "$1" | wc -c; }
-for m in pkg/input_shaping pkg/page/playground pkg/page/designer pkg/page/recording; do
+for m in "${modules[@]}"; do
   printf '[build] %s_bg.wasm: %d bytes (%d gzip); glue JS %d bytes gzip\n' \
     "$m" "$(wc -c < "${m}_bg.wasm")" "$(gz "${m}_bg.wasm")" "$(gz "$m.js")"
 done
-for b in pkg/page/main.js pkg/page/measure_worker.js pkg/page/design_worker.js; do
+for b in "${bundles[@]+"${bundles[@]}"}"; do
   printf '[build] %s (esbuild): %d bytes gzip\n' "$b" "$(gz "$b")"
 done
