@@ -63,6 +63,10 @@ layer convergence timeout 1500 cargo test --test convergence -- --nocapture
 layer wasm-node wasm-pack test --node
 layer wasm-browser wasm-pack test --headless --chrome
 layer build bash scripts/build.sh
+# The build's own checks and the package (issue 21): the input stamps that let a build skip an
+# unchanged module; `npm run pack`'s tarball installed into an empty project and run in Node,
+# esbuild bundles and Chromium (tests/package/).
+layer package node --test --test-reporter=tap tests/package/
 # Every export of every built module called through its generated glue with hostile arguments
 # (issue 21): no trap, only the documented Error. A quick run; npm run test:boundary:long for 10⁶.
 layer boundary node --test --test-reporter=tap tests/boundary/
