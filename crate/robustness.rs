@@ -75,6 +75,16 @@ pub fn parameterless_specs() -> Vec<ShaperSpec> {
 ///
 /// Errors: `vtol` outside (0, 1); more than [`MAX_TABLE_ROWS`] specs; a spec that cannot be
 /// designed for the mode (the error is prefixed `specs[i]`).
+///
+/// ```
+/// use input_shaping::{robustness::robustness_table, Mode, ShaperSpec};
+/// let rows = robustness_table(&[ShaperSpec::Zv, ShaperSpec::Zvd], &Mode::new(1.0, 0.0)?, 0.05)?;
+/// // Undamped ZV: half a period, I(5 %) = 4·asin(0.05)/π; ZVD lasts twice as long, is wider.
+/// assert!((rows[0].duration_periods - 0.5).abs() < 1e-12);
+/// assert!((rows[0].insensitivity - 4.0 * 0.05_f64.asin() / std::f64::consts::PI).abs() < 1e-9);
+/// assert!((rows[1].duration_periods - 1.0).abs() < 1e-12 && rows[1].insensitivity > rows[0].insensitivity);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn robustness_table(
     specs: &[ShaperSpec],
     mode: &Mode,

@@ -37,6 +37,15 @@ pub struct KlipperFigures {
 
 /// Smoothing (mm) of `shaper` at acceleration `accel` (mm/s²) and square corner velocity `scv`
 /// (mm/s), as Klipper's `_get_shaper_smoothing`. Times are in seconds.
+///
+/// ```
+/// use input_shaping::{design::zero_vibration::zv, smoothing::smoothing, Mode};
+/// // Smoothing grows with the acceleration: Klipper's trade-off of a longer shaper.
+/// let shaper = zv(&Mode::new(40.0, 0.1)?)?;
+/// let (low, high) = (smoothing(&shaper, 3000.0, 5.0)?, smoothing(&shaper, 6000.0, 5.0)?);
+/// assert!(0.0 < low && low < high);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn smoothing(shaper: &Shaper, accel: f64, scv: f64) -> Result<f64> {
     in_range("accel", accel)?;
     in_range("scv", scv)?;
@@ -88,6 +97,15 @@ fn in_range(field: &str, value: f64) -> Result<f64> {
 /// A shaper of zero duration (a single impulse) never smooths: its maximum acceleration is
 /// unbounded and `f64::INFINITY` is returned (`null` in JS). The search stops at
 /// [`MAX_FIGURE_INPUT`] (10¹² mm/s²), which is returned if smoothing is still below target there.
+///
+/// ```
+/// use input_shaping::{design::modified::mzv, smoothing::{max_accel, smoothing}, Mode};
+/// // The largest acceleration whose smoothing is Klipper's 0.12 mm.
+/// let shaper = mzv(&Mode::new(50.0, 0.1)?)?;
+/// let accel = max_accel(&shaper, 5.0)?;
+/// assert!((smoothing(&shaper, accel, 5.0)? - 0.12).abs() < 1e-6);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn max_accel(shaper: &Shaper, scv: f64) -> Result<f64> {
     if shaper.duration() == 0.0 {
         in_range("scv", scv)?;
@@ -128,6 +146,15 @@ pub fn max_accel(shaper: &Shaper, scv: f64) -> Result<f64> {
 }
 
 /// Both figures at Klipper's defaults (accel 5000 mm/s² for smoothing), with `scv` in mm/s.
+///
+/// ```
+/// use input_shaping::{design::zero_vibration::zvd, smoothing::*, Mode};
+/// let shaper = zvd(&Mode::new(45.0, 0.1)?)?;
+/// let figures = klipper_figures(&shaper, 5.0)?;
+/// assert_eq!(figures.smoothing, smoothing(&shaper, KLIPPER_ACCEL, 5.0)?);
+/// assert_eq!(figures.max_accel, max_accel(&shaper, 5.0)?);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn klipper_figures(shaper: &Shaper, scv: f64) -> Result<KlipperFigures> {
     Ok(KlipperFigures {
         smoothing: smoothing(shaper, KLIPPER_ACCEL, scv)?,

@@ -26,6 +26,14 @@ pub const MAX_CURVE_POINTS: usize = 100_000;
 ///
 /// The exponentials are evaluated as e^{−ζω(t_n − tᵢ)} so nothing overflows. `omega ≥ 0` and
 /// `0 ≤ zeta < 1` are the caller's to ensure; with ω = 0 the result is |Σ Aᵢ|.
+///
+/// ```
+/// use input_shaping::{vibration::vibration_rad, Impulse};
+/// let zv = [Impulse { time: 0.0, amplitude: 0.5 }, Impulse { time: 0.5, amplitude: 0.5 }];
+/// let omega = 2.0 * std::f64::consts::PI * 0.8; // 0.8 Hz on a ZV for 1 Hz: |cos(0.4π)|
+/// assert!((vibration_rad(&zv, omega, 0.0) - (0.4 * std::f64::consts::PI).cos()).abs() < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn vibration_rad(impulses: &[Impulse], omega: f64, zeta: f64) -> f64 {
     let [c, s] = vibration_moment(impulses, omega, zeta, 0);
     c.hypot(s)
@@ -40,6 +48,20 @@ pub fn vibration_rad(impulses: &[Impulse], omega: f64, zeta: f64) -> f64 {
 /// zero frequency derivatives" at (ω, ζ) (Singer & Seering 1988 §2.2; Singhose 2009 eq. 16).
 /// The multi-mode direct designs impose these as linear equalities. `t_n` is the last impulse's
 /// time, as in [`vibration_rad`].
+///
+/// ```
+/// use input_shaping::vibration::vibration_moment;
+/// use input_shaping::Impulse;
+/// // ZVD ([1, 2, 1]/4 every half period, undamped) has V = 0 and dV/dω = 0 at its mode:
+/// // its moments M₀ and M₁ vanish there, M₂ does not.
+/// let zvd = [(0.0, 0.25), (0.5, 0.5), (1.0, 0.25)].map(|(time, amplitude)| Impulse { time, amplitude });
+/// let omega = 2.0 * std::f64::consts::PI;
+/// let norm = |[c, s]: [f64; 2]| c.hypot(s);
+/// assert!(norm(vibration_moment(&zvd, omega, 0.0, 0)) < 1e-12);
+/// assert!(norm(vibration_moment(&zvd, omega, 0.0, 1)) < 1e-12);
+/// assert!(norm(vibration_moment(&zvd, omega, 0.0, 2)) > 0.1);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn vibration_moment(impulses: &[Impulse], omega: f64, zeta: f64, k: u32) -> [f64; 2] {
     let t_n = impulses.last().map_or(0.0, |imp| imp.time);
     let damped = (1.0 - zeta * zeta).sqrt();
@@ -61,6 +83,20 @@ pub fn vibration_moment(impulses: &[Impulse], omega: f64, zeta: f64, k: u32) -> 
 /// impulse of the sequence is at `t_n`: e^{−ζω(t_n − t)} (cos ω_d t, sin ω_d t). V is the length
 /// of Σ Aᵢ · phasor(tᵢ), so once the times are fixed V is the norm of a vector linear in the
 /// amplitudes (what the convex design programs of [`crate::solve`] use).
+///
+/// ```
+/// use input_shaping::vibration::{impulse_phasor, vibration_rad};
+/// use input_shaping::Impulse;
+/// // V is the length of Σ Aᵢ · phasor(tᵢ).
+/// let impulses = [Impulse { time: 0.0, amplitude: 0.6 }, Impulse { time: 0.3, amplitude: 0.4 }];
+/// let (omega, zeta, tn) = (7.0, 0.05, 0.3);
+/// let [c, s] = impulses.iter().fold([0.0, 0.0], |[c, s], i| {
+///     let [pc, ps] = impulse_phasor(i.time, tn, omega, zeta);
+///     [c + i.amplitude * pc, s + i.amplitude * ps]
+/// });
+/// assert!((c.hypot(s) - vibration_rad(&impulses, omega, zeta)).abs() < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn impulse_phasor(time: f64, t_n: f64, omega: f64, zeta: f64) -> [f64; 2] {
     let (c, s) = term(1.0, time, t_n, omega, zeta, (1.0 - zeta * zeta).sqrt());
     [c, s]
@@ -81,6 +117,15 @@ fn term(amplitude: f64, time: f64, t_n: f64, omega: f64, zeta: f64, damped: f64)
 }
 
 /// Residual vibration V of `shaper` on `mode` (fraction: 0 = none, 1 = as much as unshaped).
+///
+/// ```
+/// use input_shaping::{design::zero_vibration::zv, vibration::residual_vibration, Mode};
+/// // Undamped ZV: V(f) = |cos(πf/2f₀)| (Singhose 2009 eq. 11 with [1/2, 1/2] at [0, T/2]).
+/// let shaper = zv(&Mode::new(1.0, 0.0)?)?;
+/// let v = residual_vibration(&shaper, &Mode::new(1.1, 0.0)?);
+/// assert!((v - (0.55 * std::f64::consts::PI).cos().abs()).abs() < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn residual_vibration(shaper: &Shaper, mode: &Mode) -> f64 {
     shaper_vibration(shaper, mode.omega_rad_s(), mode.damping())
 }
@@ -175,6 +220,18 @@ pub(crate) fn damping_ratio(field: &str, zeta: f64) -> Result<f64> {
 
 /// The sensitivity curve V(f) of `shaper` over a frequency range at one damping ratio
 /// (Singhose 2009 Fig. 7).
+///
+/// ```
+/// use input_shaping::vibration::{sensitivity, SensitivityOptions};
+/// use input_shaping::{design::zero_vibration::zv, Mode};
+/// let shaper = zv(&Mode::new(1.0, 0.0)?)?;
+/// let options = SensitivityOptions { from_hz: 0.0, to_hz: 2.0, points: 21, damping: 0.0 };
+/// let curve = sensitivity(&shaper, &options)?;
+/// for (f, v) in curve.frequency_hz.iter().zip(&curve.vibration) {
+///     assert!((v - (std::f64::consts::FRAC_PI_2 * f).cos().abs()).abs() < 1e-12);
+/// }
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn sensitivity(shaper: &Shaper, options: &SensitivityOptions) -> Result<SensitivityCurve> {
     frequency_range(options.from_hz, options.to_hz)?;
     count("points", options.points, 2, MAX_CURVE_POINTS)?;
@@ -225,6 +282,17 @@ const SCAN_CHUNK: usize = 256;
 /// band edges are bracketed by a scan fine enough for the shaper's duration and refined to
 /// machine precision by the ITP method (Oliveira & Takahashi 2020: about 10 evaluations of
 /// eq. 11 per edge, never more than bisection + 3).
+///
+/// ```
+/// use input_shaping::{design::zero_vibration::zv, vibration::insensitivity, Mode};
+/// // Undamped ZV: V = |cos(πr/2)| ≤ Vtol for |r − 1| ≤ 2·asin(Vtol)/π, so I = 4·asin(Vtol)/π.
+/// let mode = Mode::new(1.0, 0.0)?;
+/// let band = insensitivity(&zv(&mode)?, &mode, 0.05)?;
+/// let half = 2.0 * 0.05_f64.asin() / std::f64::consts::PI;
+/// assert!((band.low_hz - (1.0 - half)).abs() < 1e-9 && (band.high_hz - (1.0 + half)).abs() < 1e-9);
+/// assert!((band.width - 2.0 * half).abs() < 1e-9);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensitivity> {
     tolerable_vibration(vtol)?;
     let f_m = mode.frequency_hz();
@@ -398,6 +466,19 @@ fn refine_crossing(g: &impl Fn(f64) -> f64, inside: f64, outside: f64) -> f64 {
 /// V at the evenly spaced frequencies `from_hz + k·step_hz`, k = 0 … n−1 (`step_hz` may be
 /// negative), written to `out` (cleared first): the same quantity as [`vibration_rad`] by the
 /// map's recurrence (see [`sensitivity_map`]), agreeing with it to ~1e-13 (tested).
+///
+/// ```
+/// use input_shaping::vibration::{vibration_on_grid, vibration_rad};
+/// use input_shaping::Impulse;
+/// let zvd = [(0.0, 0.25), (0.5, 0.5), (1.0, 0.25)].map(|(time, amplitude)| Impulse { time, amplitude });
+/// let mut v = Vec::new();
+/// vibration_on_grid(&zvd, 0.5, 0.01, 101, 0.02, &mut v); // 0.5 … 1.5 Hz at ζ = 0.02
+/// for (k, v) in v.iter().enumerate() {
+///     let omega = 2.0 * std::f64::consts::PI * (0.5 + 0.01 * k as f64);
+///     assert!((v - vibration_rad(&zvd, omega, 0.02)).abs() < 1e-12);
+/// }
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn vibration_on_grid(
     impulses: &[Impulse],
     from_hz: f64,
@@ -457,6 +538,19 @@ pub struct VibrationPhasor {
 /// [`VibrationPhasor`] of `impulses` (in the given order; the last one is the reference) at
 /// undamped frequency `omega` (rad/s) and damping ratio `zeta` (0 ≤ ζ < 1, the caller's to
 /// ensure).
+///
+/// ```
+/// use input_shaping::vibration::{vibration_phasor, vibration_rad};
+/// use input_shaping::Impulse;
+/// let zv = [Impulse { time: 0.0, amplitude: 0.5 }, Impulse { time: 0.5, amplitude: 0.5 }];
+/// let p = vibration_phasor(&zv, 5.0, 0.0);
+/// assert!((p.value.norm() - vibration_rad(&zv, 5.0, 0.0)).abs() < 1e-12); // |P| = V
+/// // ∂P/∂ω against a central difference.
+/// let h = 1e-6;
+/// let d = (vibration_phasor(&zv, 5.0 + h, 0.0).value - vibration_phasor(&zv, 5.0 - h, 0.0).value) / (2.0 * h);
+/// assert!((p.d_omega - d).norm() < 1e-6);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn vibration_phasor(impulses: &[Impulse], omega: f64, zeta: f64) -> VibrationPhasor {
     let lambda = nalgebra::Complex::new(zeta, (1.0 - zeta * zeta).sqrt());
     let t_last = impulses.last().map_or(0.0, |imp| imp.time);
@@ -548,6 +642,19 @@ pub struct DampingSensitivityCurve {
 /// natural frequency: how much vibration is left when the plant's damping is not the one the
 /// shaper was designed for (Singhose 2009 eq. 11 read as a function of ζ; Fig. 10 is the
 /// surface it is one section of).
+///
+/// ```
+/// use input_shaping::vibration::{damping_sensitivity, residual_vibration, DampingSensitivityOptions};
+/// use input_shaping::{design::zero_vibration::zvd, Mode};
+/// let shaper = zvd(&Mode::new(1.0, 0.0)?)?;
+/// let options = DampingSensitivityOptions { frequency_hz: 1.0, from_damping: 0.0, to_damping: 0.3, points: 7 };
+/// let curve = damping_sensitivity(&shaper, &options)?;
+/// assert!(curve.vibration[0] < 1e-12); // designed for ζ = 0
+/// for (&z, &v) in curve.damping.iter().zip(&curve.vibration) {
+///     assert!((v - residual_vibration(&shaper, &Mode::new(1.0, z)?)).abs() < 1e-12);
+/// }
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn damping_sensitivity(
     shaper: &Shaper,
     options: &DampingSensitivityOptions,
@@ -592,6 +699,19 @@ pub const MAX_BAND_DAMPING: f64 = 0.999;
 /// where V(ω_m, ζ) ≤ Vtol around the mode's damping. The edges are bracketed by a scan with step
 /// min(10⁻³, 0.1/(ω_m t_n)) in ζ (V's phase ω√(1−ζ²)tᵢ and decay ζω(t_n − tᵢ) change by at most
 /// ~ω t_n per unit of ζ away from ζ → 1) and refined by the ITP method, as in [`insensitivity`].
+///
+/// ```
+/// use input_shaping::vibration::{damping_insensitivity, residual_vibration};
+/// use input_shaping::{design::zero_vibration::zv, Mode};
+/// let mode = Mode::new(1.0, 0.1)?;
+/// let shaper = zv(&mode)?; // V = Vtol at both edges of the band
+/// let band = damping_insensitivity(&shaper, &mode, 0.05)?;
+/// assert!(band.low_damping < 0.1 && 0.1 < band.high_damping);
+/// for z in [band.low_damping, band.high_damping] {
+///     assert!((residual_vibration(&shaper, &Mode::new(1.0, z)?) - 0.05).abs() < 1e-6);
+/// }
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn damping_insensitivity(
     shaper: &Shaper,
     mode: &Mode,
@@ -684,6 +804,20 @@ impl SensitivityMap {
 /// vectorise, and every [`MAP_RESEED`] points the terms are recomputed from the formula, so
 /// rounding never accumulates over more than ~40 multiplications. Tests check
 /// every point against [`vibration_rad`] to 10⁻¹².
+///
+/// ```
+/// use input_shaping::vibration::{residual_vibration, sensitivity_map, SensitivityMapOptions};
+/// use input_shaping::{design::zero_vibration::zvd, Mode};
+/// let shaper = zvd(&Mode::new(1.0, 0.05)?)?;
+/// let options = SensitivityMapOptions {
+///     from_hz: 0.5, to_hz: 1.5, frequency_points: 11, damping_from: 0.0, damping_to: 0.2, damping_points: 5,
+/// };
+/// let map = sensitivity_map(&shaper, &options)?;
+/// let (k, j) = (1, 4); // ζ = 0.05, f = 0.9 Hz
+/// let exact = residual_vibration(&shaper, &Mode::new(map.frequency_hz[j], map.damping[k])?);
+/// assert!((map.get(k, j).unwrap() - exact).abs() < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn sensitivity_map(shaper: &Shaper, options: &SensitivityMapOptions) -> Result<SensitivityMap> {
     frequency_range(options.from_hz, options.to_hz)?;
     let nf = count(

@@ -11,6 +11,14 @@ use crate::error::Result;
 use crate::shaper::{Impulse, Shaper};
 
 /// The shaper with these impulses, optionally normalised to Σ Aᵢ = 1.
+///
+/// ```
+/// use input_shaping::{design::custom::custom, Impulse};
+/// let impulses = [Impulse { time: 0.2, amplitude: 2.0 }, Impulse { time: 0.1, amplitude: 2.0 }];
+/// let shaper = custom(&impulses, true)?; // sorted, shifted to start at 0, summing to 1
+/// assert_eq!(shaper.impulses(), [Impulse { time: 0.0, amplitude: 0.5 }, Impulse { time: 0.1, amplitude: 0.5 }]);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn custom(impulses: &[Impulse], normalize: bool) -> Result<Shaper> {
     let shaper = Shaper::new(impulses.to_vec())?;
     if normalize {

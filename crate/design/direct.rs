@@ -116,6 +116,17 @@ pub(crate) fn direct(spec: &DirectSpec, modes: &[Mode]) -> Result<(Shaper, Guara
 
 /// Designs the shortest shaper with zero vibration and `spec.derivatives` zero derivatives at
 /// every mode at once (see the module docs), checked against that guarantee.
+///
+/// ```
+/// use input_shaping::design::direct::{direct_multi_mode, DirectSpec};
+/// use input_shaping::{vibration::residual_vibration, Mode};
+/// // One shaper with ZVD's constraints at two modes at once (DirectSpec's default).
+/// let modes = [Mode::new(1.2, 0.012)?, Mode::new(3.4, 0.013)?];
+/// let shaper = direct_multi_mode(&DirectSpec::default(), &modes)?;
+/// assert!((shaper.amplitude_sum() - 1.0).abs() < 1e-9);
+/// assert!(modes.iter().all(|m| residual_vibration(&shaper, m) < 1e-6));
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn direct_multi_mode(spec: &DirectSpec, modes: &[Mode]) -> Result<Shaper> {
     let (shaper, guarantee) = direct(spec, modes)?;
     crate::design::verify(&shaper, modes, &guarantee)?;

@@ -73,12 +73,33 @@ pub struct ExtraInsensitive {
 }
 
 /// EI shaper (one hump at the mode, 3 impulses, about one damped period), Singhose 2009 §3.1.
+///
+/// ```
+/// use input_shaping::{design::extra_insensitive::ei, Mode};
+/// // Undamped, Singhose 2009 §3.1: [(1 + V)/4, (1 − V)/2, (1 + V)/4] at [0, T/2, T].
+/// let shaper = ei(&Mode::new(1.0, 0.0)?, 0.05)?;
+/// let i = shaper.impulses();
+/// assert!((i[0].amplitude - 1.05 / 4.0).abs() < 1e-9 && (i[1].amplitude - 0.95 / 2.0).abs() < 1e-9);
+/// assert!((i[1].time - 0.5).abs() < 1e-9 && (i[2].time - 1.0).abs() < 1e-9);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn ei(mode: &Mode, vtol: f64) -> Result<Shaper> {
     Ok(extra_insensitive(mode, 1, vtol)?.shaper)
 }
 
 /// n-hump EI shaper (`humps` = n, 1 … [`MAX_HUMPS`]): n + 2 impulses over about (n+1)/2
 /// damped periods.
+///
+/// ```
+/// use input_shaping::{design::extra_insensitive::ei_humps, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(1.0, 0.05)?;
+/// let shaper = ei_humps(&mode, 2, 0.05)?; // two humps: 4 impulses over about 1.5 periods
+/// assert_eq!(shaper.len(), 4);
+/// assert!((shaper.amplitude_sum() - 1.0).abs() < 1e-12);
+/// assert!((shaper.duration() / mode.damped_period_s() - 1.5).abs() < 0.05);
+/// assert!(residual_vibration(&shaper, &mode) <= 0.05);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn ei_humps(mode: &Mode, humps: u32, vtol: f64) -> Result<Shaper> {
     Ok(extra_insensitive(mode, humps, vtol)?.shaper)
 }
@@ -227,6 +248,19 @@ const MAX_ZERO_RATIO: f64 = 20.0;
 
 /// Designs the n-hump EI shaper for `mode` (module docs) and verifies it: V = Vtol at each
 /// hump and a local maximum there, V = 0 at each zero, V ≤ Vtol between the outer zeros.
+///
+/// ```
+/// use input_shaping::{design::extra_insensitive::extra_insensitive, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(5.0, 0.02)?;
+/// let ei = extra_insensitive(&mode, 1, 0.05)?;
+/// // One hump of V = Vtol at the mode, a zero on either side of it.
+/// let (hump, zeros) = (ei.humps_hz[0], &ei.zeros_hz);
+/// assert!(zeros[0] < hump && hump < zeros[1]);
+/// let at = |f: f64| Mode::new(f, 0.02).map(|m| residual_vibration(&ei.shaper, &m));
+/// assert!((at(hump)? - 0.05).abs() < 1e-9);
+/// assert!(at(zeros[0])? < 1e-9 && at(zeros[1])? < 1e-9);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn extra_insensitive(mode: &Mode, humps: u32, vtol: f64) -> Result<ExtraInsensitive> {
     check_parameters(humps, vtol)?;
     let start = undamped(humps, vtol);

@@ -249,12 +249,33 @@ pub(crate) enum Guarantee {
 const ZERO_VIBRATION_TOLERANCE: f64 = 1e-9;
 
 /// Designs the shaper a request asks for.
+///
+/// ```
+/// use input_shaping::{design, DesignRequest, ModeSpec, ShaperSpec};
+/// let request = DesignRequest {
+///     modes: vec![ModeSpec { frequency_hz: 2.0, damping: 0.05 }],
+///     shaper: ShaperSpec::Zvd,
+/// };
+/// let shaper = design(&request)?; // the ZVD shaper, checked against its guarantee
+/// assert_eq!(shaper.len(), 3);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn design(request: &DesignRequest) -> Result<Shaper> {
     let modes = Mode::list(&request.modes)?;
     design_for(&request.shaper, &modes)
 }
 
 /// Designs a shaper of family `spec` for already validated modes.
+///
+/// ```
+/// use input_shaping::{design::design_for, vibration::residual_vibration, Mode, ShaperSpec};
+/// // With several modes, the per-mode shapers convolved: V = 0 at each.
+/// let modes = [Mode::new(2.0, 0.05)?, Mode::new(7.0, 0.02)?];
+/// let shaper = design_for(&ShaperSpec::Zv, &modes)?;
+/// assert_eq!(shaper.len(), 4);
+/// assert!(modes.iter().all(|m| residual_vibration(&shaper, m) < 1e-12));
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
     checked(spec, modes, any_family)
 }
@@ -263,6 +284,15 @@ pub fn design_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
 /// optimisation solver designs: a module that calls this and not [`design_for`] leaves the
 /// other families' code out (the page's design worker, Cargo feature `js-designer`). Another
 /// family is refused at `family`.
+///
+/// ```
+/// use input_shaping::design::{design_solved_for, direct::DirectSpec};
+/// use input_shaping::{Mode, ShaperSpec};
+/// let modes = [Mode::new(2.0, 0.05)?];
+/// assert!(design_solved_for(&ShaperSpec::Direct(DirectSpec::default()), &modes).is_ok());
+/// assert!(design_solved_for(&ShaperSpec::Zv, &modes).is_err()); // not a solved family
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn design_solved_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
     checked(spec, modes, solved_family)
 }

@@ -28,6 +28,19 @@ use crate::shaper::{Impulse, Shaper};
 use std::f64::consts::{PI, SQRT_2};
 
 /// Klipper's MZV shaper for `mode`, normalised to Σ Aᵢ = 1 (module docs).
+///
+/// ```
+/// use input_shaping::{design::modified::mzv, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(40.0, 0.0)?;
+/// let shaper = mzv(&mode)?;
+/// // Undamped: [1 − 1/√2, √2 − 1, 1 − 1/√2] at [0, 0.375, 0.75]·T, zeros at f and 5f/3.
+/// let a1 = 1.0 - std::f64::consts::FRAC_1_SQRT_2;
+/// assert!((shaper.impulses()[0].amplitude - a1).abs() < 1e-12);
+/// assert!((shaper.duration() - 0.75 / 40.0).abs() < 1e-12);
+/// assert!(residual_vibration(&shaper, &mode) < 1e-12);
+/// assert!(residual_vibration(&shaper, &Mode::new(40.0 * 5.0 / 3.0, 0.0)?) < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn mzv(mode: &Mode) -> Result<Shaper> {
     let z = mode.damping();
     let df = (1.0 - z * z).sqrt();

@@ -121,6 +121,17 @@ fn solve(
 }
 
 /// UM-ZV: [1, −1, 1], V = 0 at the mode (module docs). At ζ = 0, t = [0, T/6, T/3].
+///
+/// ```
+/// use input_shaping::{design::negative::um_zv, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(1.0, 0.0)?;
+/// let shaper = um_zv(&mode)?; // undamped: [1, −1, 1] at [0, T/6, T/3]
+/// let i = shaper.impulses();
+/// assert_eq!(i.iter().map(|i| i.amplitude).collect::<Vec<_>>(), [1.0, -1.0, 1.0]);
+/// assert!((i[1].time - 1.0 / 6.0).abs() < 1e-9 && (i[2].time - 1.0 / 3.0).abs() < 1e-9);
+/// assert!(residual_vibration(&shaper, &mode) < 1e-9);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn um_zv(mode: &Mode) -> Result<Shaper> {
     let system_at = |zeta| System {
         zeta,
@@ -159,6 +170,18 @@ fn symmetric_five(x: f64, y: f64) -> Vec<f64> {
 }
 
 /// UM-ZVD: [1, −1, 1, −1, 1], V = 0 and dV/dω = 0 at the mode (module docs).
+///
+/// ```
+/// use input_shaping::{design::negative::um_zvd, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(1.0, 0.05)?;
+/// let shaper = um_zvd(&mode)?; // [1, −1, 1, −1, 1], V = 0 and dV/dω = 0 at the mode
+/// assert_eq!(shaper.len(), 5);
+/// assert!((shaper.amplitude_sum() - 1.0).abs() < 1e-12);
+/// assert!(residual_vibration(&shaper, &mode) < 1e-9);
+/// // Flat at the mode: 1 % off it, V is still below 0.1 %.
+/// assert!(residual_vibration(&shaper, &mode.with_frequency_hz(1.01)?) < 1e-3);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn um_zvd(mode: &Mode) -> Result<Shaper> {
     let system_at = |zeta| System {
         zeta,
@@ -231,6 +254,18 @@ fn first_crossing(g: &impl Fn(f64) -> f64, inside: f64, step: f64) -> Option<f64
 
 /// UM-EI: [1, −1, 1, −1, 1] with a hump V = `vtol` at the mode and zeros either side (module
 /// docs); returns the zeros and the hump too.
+///
+/// ```
+/// use input_shaping::{design::negative::um_ei_design, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(2.0, 0.0)?;
+/// let um = um_ei_design(&mode, 0.05)?;
+/// assert_eq!(um.humps_hz, [2.0]); // the hump, V = Vtol, at the mode itself
+/// assert!((residual_vibration(&um.shaper, &mode) - 0.05).abs() < 1e-9);
+/// for &f in &um.zeros_hz {
+///     assert!(residual_vibration(&um.shaper, &mode.with_frequency_hz(f)?) < 1e-9);
+/// }
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn um_ei_design(mode: &Mode, vtol: f64) -> Result<ExtraInsensitive> {
     check_parameters(1, vtol)?;
     let (x, y) = um_ei_undamped(vtol).ok_or_else(|| Error::Infeasible {
@@ -287,6 +322,15 @@ pub fn um_ei_design(mode: &Mode, vtol: f64) -> Result<ExtraInsensitive> {
 }
 
 /// UM-EI shaper (see [`um_ei_design`]).
+///
+/// ```
+/// use input_shaping::{design::negative::um_ei, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(2.0, 0.03)?;
+/// let shaper = um_ei(&mode, 0.05)?; // five impulses of ±1
+/// assert!(shaper.impulses().iter().all(|i| i.amplitude.abs() == 1.0));
+/// assert!((residual_vibration(&shaper, &mode) - 0.05).abs() < 1e-9);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn um_ei(mode: &Mode, vtol: f64) -> Result<Shaper> {
     Ok(um_ei_design(mode, vtol)?.shaper)
 }
@@ -463,6 +507,22 @@ fn end_cluster_starts(zeta: f64, delta: f64) -> Vec<DVector<f64>> {
 /// end: for long moves with damping the cluster must sit near the end, where its vibration
 /// can still cancel that of the final step. This is a search over the 3-switch solutions, not
 /// a proof of time-optimality; the tests compare it with a brute-force scan.
+///
+/// ```
+/// use input_shaping::{design::negative::bang_bang, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(1.0, 0.0)?;
+/// let (distance, max_acceleration) = (0.5, 2.0);
+/// let shaper = bang_bang(&mode, distance, max_acceleration)?; // [1, −2, 2, −2, 1]
+/// let i = shaper.impulses();
+/// assert_eq!(i.iter().map(|i| i.amplitude).collect::<Vec<_>>(), [1.0, -2.0, 2.0, -2.0, 1.0]);
+/// assert!(residual_vibration(&shaper, &mode) < 1e-9);
+/// // The acceleration a_max × (shaper ∗ step) ends at rest, `distance` away.
+/// let tf = shaper.duration();
+/// let velocity: f64 = i.iter().map(|i| i.amplitude * (tf - i.time)).sum();
+/// let position: f64 = i.iter().map(|i| i.amplitude * (tf - i.time).powi(2) / 2.0).sum();
+/// assert!(velocity.abs() < 1e-9 && (max_acceleration * position - distance).abs() < 1e-9);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn bang_bang(mode: &Mode, distance: f64, max_acceleration: f64) -> Result<Shaper> {
     let delta = move_size(mode, distance, max_acceleration)?;
     // δ = ω²D/a = 4π² D/(aT²).
@@ -521,6 +581,16 @@ pub fn bang_bang(mode: &Mode, distance: f64, max_acceleration: f64) -> Result<Sh
 /// Fuel-efficient on/off shaper [1, −1, 1, −1, −1, 1, −1, 1] with a coast of `coast_time`
 /// seconds between the accelerating and decelerating pulse pairs (module docs). Amplitudes sum
 /// to 0; apply like [`bang_bang`].
+///
+/// ```
+/// use input_shaping::{design::negative::on_off, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(1.0, 0.0)?;
+/// let shaper = on_off(&mode, 2.0, 2.0, 0.5)?; // accelerate, coast 0.5 s, decelerate
+/// let a: Vec<f64> = shaper.impulses().iter().map(|i| i.amplitude).collect();
+/// assert_eq!(a, [1.0, -1.0, 1.0, -1.0, -1.0, 1.0, -1.0, 1.0]);
+/// assert!(residual_vibration(&shaper, &mode) < 1e-9);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn on_off(
     mode: &Mode,
     distance: f64,

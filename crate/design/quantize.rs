@@ -111,6 +111,17 @@ pub struct QuantizeReport {
 }
 
 /// Rounds `shaper`'s times to the tick and its amplitudes to the resolution of `options`.
+///
+/// ```
+/// use input_shaping::design::quantize::{quantize, QuantizeOptions};
+/// use input_shaping::{design::zero_vibration::zvd, Mode};
+/// // Amplitudes in steps of 1/255 (an 8-bit PWM) that still sum to exactly 255/255.
+/// let rounded = quantize(&zvd(&Mode::new(2.0, 0.05)?)?, &QuantizeOptions::new(255))?;
+/// let steps: Vec<f64> = rounded.impulses().iter().map(|i| i.amplitude * 255.0).collect();
+/// assert!(steps.iter().all(|k| (k - k.round()).abs() < 1e-9));
+/// assert!((steps.iter().sum::<f64>() - 255.0).abs() < 1e-9);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn quantize(shaper: &Shaper, options: &QuantizeOptions) -> Result<Shaper> {
     if options.amplitude_steps == 0 {
         return Err(Error::invalid(
@@ -175,6 +186,16 @@ pub fn quantize(shaper: &Shaper, options: &QuantizeOptions) -> Result<Shaper> {
 }
 
 /// Quantises and reports V at `mode` and I(`options.vtol`) before and after.
+///
+/// ```
+/// use input_shaping::design::quantize::{quantize_with_report, QuantizeOptions};
+/// use input_shaping::{design::zero_vibration::zvd, Mode};
+/// let mode = Mode::new(2.0, 0.05)?;
+/// let report = quantize_with_report(&zvd(&mode)?, &mode, &QuantizeOptions::new(16))?;
+/// assert!(report.vibration_before < 1e-12); // ZVD cancels the mode; rounding costs a little
+/// assert!(report.vibration_after > 0.0 && report.vibration_after < 0.05);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn quantize_with_report(
     shaper: &Shaper,
     mode: &Mode,

@@ -185,6 +185,16 @@ pub struct SampledDesign {
 /// The ramp delay τ = 2ζ/ω + Σ Aᵢtᵢ / Σ Aᵢ of a shaper on a mode (Kamel et al. eq. 10, which
 /// assumes Σ Aᵢ = 1), in seconds: how far the plant's response to a slow ramp lags the
 /// unshaped ramp. ω is the undamped natural frequency in rad/s.
+///
+/// ```
+/// use input_shaping::{design::sampled::ramp_delay, design::zero_vibration::zv, Mode};
+/// // Kamel et al. eq. 10: τ = 2ζ/ω + Σ Aᵢtᵢ; ZV's centroid is at K·(T_d/2)/(1 + K).
+/// let mode = Mode::new(2.0, 0.1)?;
+/// let k = mode.half_period_decay();
+/// let tau = 2.0 * 0.1 / mode.omega_rad_s() + k * mode.damped_period_s() / 2.0 / (1.0 + k);
+/// assert!((ramp_delay(&zv(&mode)?, &mode)? - tau).abs() < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn ramp_delay(shaper: &Shaper, mode: &Mode) -> Result<f64> {
     let centroid = shaper.centroid_delay().ok_or_else(|| {
         Error::invalid(
@@ -834,6 +844,18 @@ fn csc(
 
 /// Designs the sampled shaper `spec` describes for one mode, and checks what it promises:
 /// V = 0 at the mode, times on the grid, Σ A = 1, the ramp delay mT if asked, the bounds.
+///
+/// ```
+/// use input_shaping::design::sampled::{design, SampledSpec};
+/// use input_shaping::{vibration::residual_vibration, Mode};
+/// // A shaper on a 10 ms controller period (Kamel et al.): 40 samples for a 2 Hz mode.
+/// let mode = Mode::new(2.0, 0.05)?;
+/// let d = design(&mode, &SampledSpec::new(0.01, 40))?;
+/// assert!(d.shaper.impulses().iter().all(|i| (i.time / 0.01 - (i.time / 0.01).round()).abs() < 1e-9));
+/// assert!((d.shaper.amplitude_sum() - 1.0).abs() < 1e-9);
+/// assert!(residual_vibration(&d.shaper, &mode) < 1e-9);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn design(mode: &Mode, spec: &SampledSpec) -> Result<SampledDesign> {
     let problem = Problem::new(mode, spec)?;
     let amplitudes = problem.solve()?;
@@ -861,6 +883,16 @@ pub fn design(mode: &Mode, spec: &SampledSpec) -> Result<SampledDesign> {
 }
 
 /// Designs for a list of modes: the sampled family designs for exactly one.
+///
+/// ```
+/// use input_shaping::design::sampled::{design_for_modes, SampledSpec};
+/// use input_shaping::Mode;
+/// let spec = SampledSpec::new(0.01, 40);
+/// assert!(design_for_modes(&[Mode::new(2.0, 0.05)?], &spec).is_ok());
+/// // The sampled family designs for one mode: a second is refused.
+/// assert!(design_for_modes(&[Mode::new(2.0, 0.05)?, Mode::new(5.0, 0.05)?], &spec).is_err());
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn design_for_modes(modes: &[Mode], spec: &SampledSpec) -> Result<SampledDesign> {
     match modes {
         [mode] => design(mode, spec),
@@ -972,6 +1004,16 @@ pub struct SampledReport {
 
 /// Designs and reports: the design of `spec` and, for comparison, the minimum-norm design with
 /// the same constraints, both costed with the spec's Q and reference.
+///
+/// ```
+/// use input_shaping::design::sampled::{report, SampledSpec};
+/// use input_shaping::Mode;
+/// let r = report(&[Mode::new(2.0, 0.05)?], &SampledSpec::new(0.01, 40))?;
+/// // The designed amplitudes cost no more than the minimum-norm ones under the same constraints.
+/// assert!(r.cost.total <= r.baseline_cost.total * (1.0 + 1e-9));
+/// assert!((r.cost_reduction - (1.0 - r.cost.total / r.baseline_cost.total)).abs() < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn report(modes: &[Mode], spec: &SampledSpec) -> Result<SampledReport> {
     let designed = design_for_modes(modes, spec)?;
     let baseline_spec = SampledSpec {

@@ -356,6 +356,19 @@ pub(crate) fn si(spec: &SiSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee)> {
 }
 
 /// Designs an SI shaper for `modes` (see the module docs), checked against its guarantee.
+///
+/// ```
+/// use input_shaping::design::specified::{specified_insensitivity, SiSpec};
+/// use input_shaping::{vibration::residual_vibration, Mode};
+/// // V ≤ 5 % over 0.8 … 1.2 Hz (I = 0.4 around a 1 Hz mode), the shortest such shaper.
+/// let spec = SiSpec { vtol: 0.05, insensitivity: Some(0.4), ..SiSpec::default() };
+/// let shaper = specified_insensitivity(&spec, &[Mode::new(1.0, 0.0)?])?;
+/// for k in 0..=40 {
+///     let f = 0.8 + 0.4 * k as f64 / 40.0;
+///     assert!(residual_vibration(&shaper, &Mode::new(f, 0.0)?) <= 0.05 + 1e-6);
+/// }
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn specified_insensitivity(spec: &SiSpec, modes: &[Mode]) -> Result<Shaper> {
     let (shaper, guarantee) = si(spec, modes)?;
     crate::design::verify(&shaper, modes, &guarantee)?;

@@ -19,22 +19,68 @@ use crate::shaper::{Impulse, Shaper};
 pub const MAX_DERIVATIVES: u32 = 30;
 
 /// ZV shaper (Singhose 2009 eqs. 14–15): two impulses [1, K]/(1+K) at [0, T_d/2].
+///
+/// ```
+/// use input_shaping::{design::zero_vibration::zv, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(10.0, 0.0)?; // undamped: K = 1, so [1, 1]/2 at [0, T/2]
+/// let shaper = zv(&mode)?;
+/// let i = shaper.impulses();
+/// assert_eq!(i.len(), 2);
+/// assert!((i[0].amplitude - 0.5).abs() < 1e-12 && (i[1].amplitude - 0.5).abs() < 1e-12);
+/// assert!((i[1].time - 0.05).abs() < 1e-12);
+/// assert!(residual_vibration(&shaper, &mode) < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn zv(mode: &Mode) -> Result<Shaper> {
     zv_dn(mode, 0)
 }
 
 /// ZVD shaper (Singhose 2009 eq. 17): [1, 2K, K²]/(1+K)² at [0, T_d/2, T_d].
+///
+/// ```
+/// use input_shaping::{design::zero_vibration::zvd, Mode};
+/// let mode = Mode::new(2.0, 0.1)?;
+/// let k = (-0.1 * std::f64::consts::PI / (1.0_f64 - 0.01).sqrt()).exp();
+/// let shaper = zvd(&mode)?;
+/// let a: Vec<f64> = shaper.impulses().iter().map(|i| i.amplitude).collect();
+/// let expected = [1.0, 2.0 * k, k * k].map(|x| x / ((1.0 + k) * (1.0 + k)));
+/// assert!(a.iter().zip(expected).all(|(a, e)| (a - e).abs() < 1e-12));
+/// assert!((shaper.duration() - mode.damped_period_s()).abs() < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn zvd(mode: &Mode) -> Result<Shaper> {
     zv_dn(mode, 1)
 }
 
 /// ZVDD shaper (Singer & Seering 1988 eq. 8): [1, 3K, 3K², K³]/(1+K)³ at i·T_d/2.
+///
+/// ```
+/// use input_shaping::{design::zero_vibration::zvdd, Mode};
+/// let shaper = zvdd(&Mode::new(1.0, 0.0)?)?; // undamped: [1, 3, 3, 1]/8 every half period
+/// let a: Vec<f64> = shaper.impulses().iter().map(|i| i.amplitude).collect();
+/// assert!(a.iter().zip([1.0, 3.0, 3.0, 1.0]).all(|(a, e)| (a - e / 8.0).abs() < 1e-12));
+/// assert!((shaper.duration() - 1.5).abs() < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn zvdd(mode: &Mode) -> Result<Shaper> {
     zv_dn(mode, 2)
 }
 
 /// ZV-Dⁿ: zero vibration and `derivatives` zero derivatives at the mode; binomial amplitudes in
 /// K, impulses every half damped period.
+///
+/// ```
+/// use input_shaping::{design::zero_vibration::zv_dn, vibration::residual_vibration, Mode};
+/// let mode = Mode::new(1.0, 0.0)?;
+/// let shaper = zv_dn(&mode, 3)?; // 5 impulses, binomial [1, 4, 6, 4, 1]/16
+/// assert_eq!(shaper.len(), 5);
+/// assert!((shaper.impulses()[2].amplitude - 6.0 / 16.0).abs() < 1e-12);
+/// // Undamped, V(f) = |cos(πf/2f₀)|⁴: four zero derivatives flatten it at the mode.
+/// let off = Mode::new(1.1, 0.0)?;
+/// let v = (0.55 * std::f64::consts::PI).cos().abs().powi(4);
+/// assert!((residual_vibration(&shaper, &off) - v).abs() < 1e-12);
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
 pub fn zv_dn(mode: &Mode, derivatives: u32) -> Result<Shaper> {
     if derivatives > MAX_DERIVATIVES {
         return Err(Error::TooLarge {
