@@ -35,7 +35,7 @@ before(() => {
   writeFileSync(join(dir, 'main.mjs'), "import { run } from './example.mjs';\nconsole.log(JSON.stringify(await run()));\n");
   sh('npm', ['install', '--offline', '--no-audit', '--no-fund', '--no-package-lock', tgz]);
 });
-after(() => rmSync(tmp, { recursive: true, force: true }));
+after(() => { if (tmp) rmSync(tmp, { recursive: true, force: true }); });
 
 /** V of a shaper at a mode, Singhose 2009 eq. 11, written here independently of the crate. */
 function vibration(impulses, { frequencyHz, damping }) {
