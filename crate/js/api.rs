@@ -317,7 +317,8 @@ pub fn export_shaper(
 #[wasm_bindgen(js_name = klipperFigures, unchecked_return_type = "KlipperFigures")]
 pub fn klipper_figures(
     #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
-    #[wasm_bindgen(unchecked_optional_param_type = "KlipperFiguresOptions")] options: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "KlipperFiguresOptions | null")]
+    options: JsValue,
 ) -> Result<JsValue, JsValue> {
     #[derive(Deserialize)]
     struct Options {
@@ -328,7 +329,7 @@ pub fn klipper_figures(
         crate::smoothing::KLIPPER_SCV
     }
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
-    let options: Options = if options.is_undefined() {
+    let options: Options = if options.is_undefined() || options.is_null() {
         Options { scv: default_scv() }
     } else {
         from_js(options, "options").map_err(js_error)?

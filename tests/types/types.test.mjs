@@ -159,6 +159,7 @@ function calls(api) {
   add('RobustnessRow[]', api.robustnessTable(mode, 0.05, [{ family: 'ei', vtol: 0.1 }, { family: 'sampled', periodS: 0.05, impulses: 20 }]));
   for (const format of ['csv', 'json', 'c', 'cFixed', 'rrf']) add('string', api.exportShaper(zvd, { format }));
   add('KlipperFigures', api.klipperFigures(zvd));
+  add('KlipperFigures', api.klipperFigures(zvd, null));
   add('KlipperFigures', api.klipperFigures({ impulses: [{ time: 0, amplitude: 1 }] }, { scv: 5 }));
   add('number', api.rampDelay(zvd, mode));
   add('SampledReport', api.sampledReport({ family: 'sampled', periodS: 0.05, impulses: 20, delaySamples: 5, modes: [mode] }));
