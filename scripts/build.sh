@@ -71,6 +71,11 @@ build_module() {
   rm -rf "$out/$name.js" "$out/${name}_bg.wasm"
   wasm-bindgen --target web --out-dir "$out" --out-name "$name" --remove-producers-section \
     "$dir/$target/release/input_shaping.wasm"
+  # wasm-bindgen types the raw wasm exports' externref arguments `any` (`InitOutput`,
+  # `*_bg.wasm.d.ts`). They take any JS value: `unknown` says so without switching type
+  # checking off, so no `any` is left in a public signature (docs/js-api.md, *TypeScript*).
+  sed -i -E '/^ *(readonly|export const) [A-Za-z0-9_$]+: \(/ s/\bany\b/unknown/g' \
+    "$out/$name.d.ts" "$out/${name}_bg.wasm.d.ts"
   echo "[build] $out/$name.js ($features): built by $how"
 }
 

@@ -70,6 +70,9 @@ layer package node --test --test-reporter=tap tests/package/
 # Every export of every built module called through its generated glue with hostile arguments
 # (issue 21): no trap, only the documented Error. A quick run; npm run test:boundary:long for 10⁶.
 layer boundary node --test --test-reporter=tap tests/boundary/
+# The TypeScript declarations of pkg/ (issue 21 item 2): an example compiles with tsc --strict,
+# each deliberate mistake fails to compile, every export's real result has its declared type.
+layer types node --test --test-reporter=tap tests/types/
 # A test that hangs (a page stuck in a loop) fails after 5 minutes instead of stalling CI.
 layer e2e node --test --test-timeout=300000 --test-reporter=tap tests/e2e/
 

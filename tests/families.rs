@@ -303,3 +303,136 @@ fn docs_family_tables_agree_with_families() {
         }
     }
 }
+
+/// Whether `spec` parses as a shaper spec.
+fn parses(spec: &Map<String, Value>) -> bool {
+    serde_json::from_value::<ShaperSpec>(Value::Object(spec.clone())).is_ok()
+}
+
+/// A family's TypeScript interface name: `zvdn` → `ZvdnSpec`.
+fn ts_name(family: &str) -> String {
+    let mut chars = family.chars();
+    let first = chars.next().map(|c| c.to_ascii_uppercase());
+    first.into_iter().chain(chars).collect::<String>() + "Spec"
+}
+
+/// A parameter's TypeScript type. Its shape comes from the table (`kind`, `options`); whether a
+/// list has a fixed length, and whether `null` is read (as "not given"), is asked of the spec
+/// parser itself, so the declaration says what the library accepts.
+fn ts_type(row: &FamilyInfo, p: &ParamInfo) -> String {
+    let with = |v: Value| {
+        let mut spec = defaults(row);
+        spec.insert(p.name.into(), v);
+        parses(&spec)
+    };
+    let base = match p.kind {
+        ParamKind::Number | ParamKind::Integer | ParamKind::Percent => "number".to_string(),
+        ParamKind::Numbers if with(json!([1.0, 2.0])) && !with(json!([1.0, 2.0, 3.0])) => {
+            "[number, number]".into()
+        }
+        ParamKind::Numbers => "number[]".into(),
+        ParamKind::Select => {
+            let options: Vec<String> = p.options.iter().map(|o| format!("\"{o}\"")).collect();
+            options.join(" | ")
+        }
+        ParamKind::Boolean => "boolean".into(),
+        ParamKind::Pairs => "Impulse[]".into(),
+        ParamKind::Points => "[number, number][]".into(),
+    };
+    if with(Value::Null) {
+        format!("{base} | null")
+    } else {
+        base
+    }
+}
+
+/// A parameter's doc comment: its label, kind, limits and default as the table gives them.
+fn ts_doc(p: &ParamInfo) -> String {
+    let mut doc = format!("{}.", p.label);
+    let kind = match p.kind {
+        ParamKind::Integer => " An integer.",
+        ParamKind::Percent => " A fraction (0.05 = 5 %).",
+        _ => "",
+    };
+    doc += kind;
+    match (p.min, p.max) {
+        (Some(a), Some(b)) => doc += &format!(" {} … {}.", num(a), num(b)),
+        (None, Some(b)) => doc += &format!(" At most {}.", num(b)),
+        (Some(a), None) => doc += &format!(" At least {}.", num(a)),
+        (None, None) => {}
+    }
+    match p.default {
+        Some(ParamDefault::Number(d)) => doc += &format!(" Editor default {}.", num(d)),
+        Some(ParamDefault::Text(t)) => doc += &format!(" Editor default `\"{t}\"`."),
+        Some(ParamDefault::Flag(b)) => doc += &format!(" Editor default `{b}`."),
+        Some(ParamDefault::Impulses(_)) | None => {}
+    }
+    doc.replace("*/", "* /")
+}
+
+/// The TypeScript declarations of the family specs (`crate/js/families.d.ts`, appended to the
+/// generated `.d.ts` of every module): one interface per row, discriminated by `family`, with
+/// each parameter typed from the table and required exactly when the spec parser refuses a
+/// spec without it.
+fn typescript() -> String {
+    let mut out = String::from(
+        "// Generated from FAMILIES (crate/design/family.rs) by tests/families.rs: do not edit.\n\
+         // `UPDATE_DOCS=1 cargo test --test families` rewrites it. docs/js-api.md, *TypeScript*.\n",
+    );
+    for row in FAMILIES {
+        out += &format!(
+            "\n/** `{}`: {}. Guarantees: {}. Source: {}. */\nexport interface {} {{\n  family: \"{}\";\n",
+            row.name,
+            row.title,
+            row.guarantee.replace("*/", "* /"),
+            row.source,
+            ts_name(row.name),
+            row.name
+        );
+        for p in row.params {
+            let mut without = defaults(row);
+            without.remove(p.name);
+            let optional = if parses(&without) { "?" } else { "" };
+            out += &format!(
+                "  /** {} */\n  {}{optional}: {};\n",
+                ts_doc(p),
+                p.name,
+                ts_type(row, p)
+            );
+        }
+        out += "}\n";
+    }
+    let names: Vec<String> = FAMILIES.iter().map(|f| ts_name(f.name)).collect();
+    out += &format!(
+        "\n/** A shaper family and its parameters, discriminated by `family` (docs/families.md). */\n\
+         export type ShaperSpec =\n  | {};\n",
+        names.join("\n  | ")
+    );
+    out += "\n/** Every family's name. */\nexport type FamilyName = ShaperSpec[\"family\"];\n";
+    out += "\n/** The families that need the optimisation solver (`solver` not `\"never\"`). */\n";
+    let solved: Vec<String> = FAMILIES
+        .iter()
+        .filter(|f| f.solver != Solver::Never)
+        .map(|f| format!("\"{}\"", f.name))
+        .collect();
+    out += &format!("export type SolvedFamilyName = {};\n", solved.join(" | "));
+    out
+}
+
+/// `crate/js/families.d.ts` is the one [`typescript`] makes from `FAMILIES` (with
+/// `UPDATE_DOCS=1`, rewritten instead).
+#[test]
+fn typescript_family_specs_agree_with_families() {
+    let path = format!("{}/crate/js/families.d.ts", env!("CARGO_MANIFEST_DIR"));
+    let want = typescript();
+    if std::env::var_os("UPDATE_DOCS").is_some() {
+        std::fs::write(&path, &want).unwrap();
+    } else {
+        let text = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            want == text,
+            "crate/js/families.d.ts differs from FAMILIES; run UPDATE_DOCS=1 cargo test --test \
+             families and check the diff"
+        );
+    }
+}

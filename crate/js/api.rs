@@ -97,8 +97,10 @@ fn mode_from_js(value: JsValue, what: &str) -> Result<Mode, Error> {
 /// `design(spec)`: `spec = { family, modes: [{ frequencyHz, damping }], …parameters }` →
 /// `{ impulses: [{ time, amplitude }], duration }`.
 #[cfg(any(feature = "js-api", feature = "js-designer"))]
-#[wasm_bindgen]
-pub fn design(spec: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(unchecked_return_type = "Shaper")]
+pub fn design(
+    #[wasm_bindgen(unchecked_param_type = "DesignSpec")] spec: JsValue,
+) -> Result<JsValue, JsValue> {
     let request: DesignRequest = from_js_root(spec, "spec").map_err(js_error)?;
     #[cfg(feature = "js-api")]
     let shaper = design::design(&request).map_err(js_error)?;
@@ -113,7 +115,10 @@ pub fn design(spec: JsValue) -> Result<JsValue, JsValue> {
 /// `residualVibration(shaper, { frequencyHz, damping })` → V as a fraction (1 = unshaped).
 #[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = residualVibration)]
-pub fn residual_vibration(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue> {
+pub fn residual_vibration(
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "ModeSpec")] mode: JsValue,
+) -> Result<f64, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
     let mode = mode_from_js(mode, "mode").map_err(js_error)?;
     Ok(vibration::residual_vibration(&shaper, &mode))
@@ -122,8 +127,11 @@ pub fn residual_vibration(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue
 /// `sensitivity(shaper, { fromHz, toHz, points, damping })` →
 /// `{ frequencyHz: number[], vibration: number[] }`.
 #[cfg(feature = "js-api")]
-#[wasm_bindgen]
-pub fn sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(unchecked_return_type = "SensitivityCurve")]
+pub fn sensitivity(
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "SensitivityOptions")] options: JsValue,
+) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
     let options: SensitivityOptions = from_js(options, "options").map_err(js_error)?;
     let curve = vibration::sensitivity(&shaper, &options).map_err(js_error)?;
@@ -133,10 +141,10 @@ pub fn sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue
 /// `insensitivity(shaper, { frequencyHz, damping }, vtol)` → `{ lowHz, highHz, width }`, the
 /// band around the mode where V ≤ vtol, width as a fraction of `frequencyHz`.
 #[cfg(feature = "js-api")]
-#[wasm_bindgen]
+#[wasm_bindgen(unchecked_return_type = "Insensitivity")]
 pub fn insensitivity(
-    shaper: JsValue,
-    mode: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "ModeSpec")] mode: JsValue,
     #[wasm_bindgen(unchecked_param_type = "number")] vtol: JsValue,
 ) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
@@ -163,8 +171,11 @@ pub(crate) fn set(object: &js_sys::Object, key: &str, value: &JsValue) -> Result
 /// (`vibration[k * frequencyHz.length + j]` is V at `damping[k]`, `frequencyHz[j]`). The grid
 /// is returned as a typed array because copying it is far cheaper than building a JS array.
 #[cfg(feature = "js-api")]
-#[wasm_bindgen(js_name = sensitivityMap)]
-pub fn sensitivity_map(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(js_name = sensitivityMap, unchecked_return_type = "SensitivityMap")]
+pub fn sensitivity_map(
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "SensitivityMapOptions")] options: JsValue,
+) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
     let options: vibration::SensitivityMapOptions =
         from_js(options, "options").map_err(js_error)?;
@@ -180,8 +191,11 @@ pub fn sensitivity_map(shaper: JsValue, options: JsValue) -> Result<JsValue, JsV
 /// `dampingSensitivity(shaper, { frequencyHz, fromDamping, toDamping, points })` →
 /// `{ damping: number[], vibration: number[] }`: V over damping ratios at one frequency.
 #[cfg(feature = "js-api")]
-#[wasm_bindgen(js_name = dampingSensitivity)]
-pub fn damping_sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(js_name = dampingSensitivity, unchecked_return_type = "DampingSensitivityCurve")]
+pub fn damping_sensitivity(
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "DampingSensitivityOptions")] options: JsValue,
+) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
     let options: vibration::DampingSensitivityOptions =
         from_js(options, "options").map_err(js_error)?;
@@ -193,10 +207,10 @@ pub fn damping_sensitivity(shaper: JsValue, options: JsValue) -> Result<JsValue,
 /// `{ lowDamping, highDamping, width }`: the band of damping ratios around the mode's where
 /// V ≤ vtol at the mode's frequency; `width = highDamping − lowDamping`.
 #[cfg(feature = "js-api")]
-#[wasm_bindgen(js_name = dampingInsensitivity)]
+#[wasm_bindgen(js_name = dampingInsensitivity, unchecked_return_type = "DampingInsensitivity")]
 pub fn damping_insensitivity(
-    shaper: JsValue,
-    mode: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "ModeSpec")] mode: JsValue,
     #[wasm_bindgen(unchecked_param_type = "number")] vtol: JsValue,
 ) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
@@ -212,11 +226,11 @@ pub fn damping_insensitivity(
 /// `specs` is an array of `{ family, …parameters }`; without it, every family that needs no
 /// parameters.
 #[cfg(feature = "js-api")]
-#[wasm_bindgen(js_name = robustnessTable)]
+#[wasm_bindgen(js_name = robustnessTable, unchecked_return_type = "RobustnessRow[]")]
 pub fn robustness_table(
-    mode: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "ModeSpec")] mode: JsValue,
     #[wasm_bindgen(unchecked_param_type = "number")] vtol: JsValue,
-    specs: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "ShaperSpec[] | null")] specs: JsValue,
 ) -> Result<JsValue, JsValue> {
     let mode = mode_from_js(mode, "mode").map_err(js_error)?;
     let vtol = super::args::number(&vtol, "vtol").map_err(js_error)?;
@@ -231,7 +245,7 @@ pub fn robustness_table(
 
 /// `families()` → the table of shaper families: `[{ name, title, guarantee, parameters, source }]`.
 #[cfg(feature = "js-playground")]
-#[wasm_bindgen]
+#[wasm_bindgen(unchecked_return_type = "FamilyInfo[]")]
 pub fn families() -> Result<JsValue, JsValue> {
     to_js(&design::FAMILIES)
 }
@@ -263,7 +277,10 @@ struct ExportOptions {
 /// `M593 P"custom"` line).
 #[cfg(feature = "js-playground")]
 #[wasm_bindgen(js_name = exportShaper)]
-pub fn export_shaper(shaper: JsValue, options: JsValue) -> Result<String, JsValue> {
+pub fn export_shaper(
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "ExportOptions")] options: JsValue,
+) -> Result<String, JsValue> {
     use crate::export;
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
     let options: ExportOptions = from_js(options, "options").map_err(js_error)?;
@@ -297,8 +314,12 @@ pub fn export_shaper(shaper: JsValue, options: JsValue) -> Result<String, JsValu
 /// `scv` is the square corner velocity in mm/s, default 5). `maxAccel` is `null` for a single
 /// impulse (unbounded).
 #[cfg(feature = "js-api")]
-#[wasm_bindgen(js_name = klipperFigures)]
-pub fn klipper_figures(shaper: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(js_name = klipperFigures, unchecked_return_type = "KlipperFigures")]
+pub fn klipper_figures(
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "KlipperFiguresOptions | null")]
+    options: JsValue,
+) -> Result<JsValue, JsValue> {
     #[derive(Deserialize)]
     struct Options {
         #[serde(default = "default_scv")]
@@ -308,7 +329,7 @@ pub fn klipper_figures(shaper: JsValue, options: JsValue) -> Result<JsValue, JsV
         crate::smoothing::KLIPPER_SCV
     }
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
-    let options: Options = if options.is_undefined() {
+    let options: Options = if options.is_undefined() || options.is_null() {
         Options { scv: default_scv() }
     } else {
         from_js(options, "options").map_err(js_error)?
@@ -322,7 +343,10 @@ pub fn klipper_figures(shaper: JsValue, options: JsValue) -> Result<JsValue, JsV
 /// of the plant's response to a slow ramp (Kamel, Lange & Hirzinger eq. 10).
 #[cfg(feature = "js-api")]
 #[wasm_bindgen(js_name = rampDelay)]
-pub fn ramp_delay(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue> {
+pub fn ramp_delay(
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "ModeSpec")] mode: JsValue,
+) -> Result<f64, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
     let mode = mode_from_js(mode, "mode").map_err(js_error)?;
     design::sampled::ramp_delay(&shaper, &mode).map_err(|e| js_error(e.within("shaper")))
@@ -333,8 +357,10 @@ pub fn ramp_delay(shaper: JsValue, mode: JsValue) -> Result<f64, JsValue> {
 /// the design `design(spec)` returns plus its ramp delay (eq. 10) and cost J_q (eq. 17), and the
 /// cost of the minimum-norm shaper under the same constraints.
 #[cfg(feature = "js-api")]
-#[wasm_bindgen(js_name = sampledReport)]
-pub fn sampled_report(spec: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(js_name = sampledReport, unchecked_return_type = "SampledReport")]
+pub fn sampled_report(
+    #[wasm_bindgen(unchecked_param_type = "SampledDesignSpec")] spec: JsValue,
+) -> Result<JsValue, JsValue> {
     let request: DesignRequest = from_js_root(spec, "spec").map_err(js_error)?;
     let ShaperSpec::Sampled(sampled) = &request.shaper else {
         return Err(js_error(Error::invalid(
@@ -355,8 +381,12 @@ pub fn sampled_report(spec: JsValue) -> Result<JsValue, JsValue> {
 /// insensitivityBefore, insensitivityAfter }`: the shaper rounded for an integer controller
 /// (Peláez & Singhose 2002) and what rounding cost at the mode.
 #[cfg(feature = "js-api")]
-#[wasm_bindgen]
-pub fn quantize(shaper: JsValue, mode: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(unchecked_return_type = "QuantizeReport")]
+pub fn quantize(
+    #[wasm_bindgen(unchecked_param_type = "ShaperInput")] shaper: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "ModeSpec")] mode: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "QuantizeOptions")] options: JsValue,
+) -> Result<JsValue, JsValue> {
     let shaper = shaper_from_js(shaper).map_err(js_error)?;
     let mode = mode_from_js(mode, "mode").map_err(js_error)?;
     let options: design::quantize::QuantizeOptions =
@@ -371,8 +401,10 @@ pub fn quantize(shaper: JsValue, mode: JsValue, options: JsValue) -> Result<JsVa
 /// endpoint, endpointVelocity, endpointAcceleration, deflection, swingAngle?, metrics },
 /// shaped (same, or null), shaper, modesHz, samplePeriod }`. See the README for every field.
 #[cfg(feature = "js-api")]
-#[wasm_bindgen]
-pub fn simulate(spec: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(unchecked_return_type = "SimulationResult")]
+pub fn simulate(
+    #[wasm_bindgen(unchecked_param_type = "SimulationSpec")] spec: JsValue,
+) -> Result<JsValue, JsValue> {
     let spec: crate::scenario::SimulationSpec = from_js_root(spec, "spec").map_err(js_error)?;
     let result = crate::scenario::run(&spec).map_err(js_error)?;
     to_js(&result)
@@ -382,8 +414,10 @@ pub fn simulate(spec: JsValue) -> Result<JsValue, JsValue> {
 /// signal? }` → `{ frequencyHz, magnitude, unshaped, modesHz }` (|U(f)| of the shaped and the
 /// unshaped command's velocity by default).
 #[cfg(feature = "js-api")]
-#[wasm_bindgen]
-pub fn spectrum(spec: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(unchecked_return_type = "SpectrumResult")]
+pub fn spectrum(
+    #[wasm_bindgen(unchecked_param_type = "SpectrumSpec")] spec: JsValue,
+) -> Result<JsValue, JsValue> {
     let spec: crate::scenario::SpectrumSpec = from_js_root(spec, "spec").map_err(js_error)?;
     let result = crate::scenario::spectrum_for(&spec).map_err(js_error)?;
     to_js(&result)

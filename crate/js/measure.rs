@@ -190,10 +190,10 @@ fn psd_to_js(psd: &Psd) -> Result<JsValue, JsValue> {
 /// shapers: [{ name, frequencyHz, values }], extra: [{ name, values }], runs: [{ name, values }]
 /// }`. Errors carry `line`, `column`, `columnName` and `file` (the `fileName` option).
 #[cfg(feature = "js-api")]
-#[wasm_bindgen(js_name = parseRecording)]
+#[wasm_bindgen(js_name = parseRecording, unchecked_return_type = "ParsedRecording")]
 pub fn parse_recording(
     #[wasm_bindgen(unchecked_param_type = "string")] text: JsValue,
-    options: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "RecordingOptions | null")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
     let text = args::string(&text, "text").map_err(js_error)?;
     let options: RecordingOptions = self::options(options, "options").map_err(js_error)?;
@@ -215,7 +215,9 @@ pub struct JsRecordingParser {
 impl JsRecordingParser {
     /// A parser with the options of `parseRecording`.
     #[wasm_bindgen(constructor)]
-    pub fn new(options: JsValue) -> Result<JsRecordingParser, JsValue> {
+    pub fn new(
+        #[wasm_bindgen(unchecked_optional_param_type = "RecordingOptions | null")] options: JsValue,
+    ) -> Result<JsRecordingParser, JsValue> {
         let options: RecordingOptions = self::options(options, "options").map_err(js_error)?;
         Ok(JsRecordingParser {
             inner: Some(recording::RecordingParser::new(options)),
@@ -250,6 +252,7 @@ impl JsRecordingParser {
     }
 
     /// Ends the input and returns the recording (see `parseRecording`).
+    #[wasm_bindgen(unchecked_return_type = "ParsedRecording")]
     pub fn finish(&mut self) -> Result<JsValue, JsValue> {
         let p = self
             .inner
@@ -267,8 +270,11 @@ impl JsRecordingParser {
 /// Klipper's settings instead. (In the recording module too: the page's measured-data worker
 /// forms Klipper's spectra of raw recordings with it.)
 #[cfg(feature = "js-recording")]
-#[wasm_bindgen(js_name = welch)]
-pub fn welch_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(js_name = welch, unchecked_return_type = "Psd")]
+pub fn welch_js(
+    #[wasm_bindgen(unchecked_param_type = "Signal")] signal: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "WelchOptions | KlipperWelchOptions")] options: JsValue,
+) -> Result<JsValue, JsValue> {
     let x = f64_vec(&signal, "signal").map_err(js_error)?;
     let preset = get(&options, "preset").as_string();
     let opts: WelchOptions = if preset.as_deref() == Some("klipper") {
@@ -284,8 +290,11 @@ pub fn welch_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
 /// `fftSpectrum(signal, { sampleRateHz, window?, kaiserBeta?, detrend? })` → `{ frequencyHz,
 /// magnitude (Float64Array), resolutionHz }`: the amplitude spectrum of the whole record.
 #[cfg(feature = "js-recording")]
-#[wasm_bindgen(js_name = fftSpectrum)]
-pub fn fft_spectrum_js(signal: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(js_name = fftSpectrum, unchecked_return_type = "AmplitudeSpectrum")]
+pub fn fft_spectrum_js(
+    #[wasm_bindgen(unchecked_param_type = "Signal")] signal: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "FftOptions")] options: JsValue,
+) -> Result<JsValue, JsValue> {
     let x = f64_vec(&signal, "signal").map_err(js_error)?;
     let opts: FftOptions = from_js(options, "options").map_err(js_error)?;
     let s = fft_spectrum(&x, &opts).map_err(js_error)?;
@@ -372,8 +381,11 @@ mod serde_json_like {
 /// sweep: { bandHz, rateHzPerS } | null }` (`sweep`: the linear sweep read from a raw recording,
 /// whose modes were then fitted on its whole-record periodogram; `null` otherwise).
 #[cfg(feature = "js-recording")]
-#[wasm_bindgen(js_name = identifyModes)]
-pub fn identify_modes(recording: JsValue, options: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(js_name = identifyModes, unchecked_return_type = "Identification")]
+pub fn identify_modes(
+    #[wasm_bindgen(unchecked_param_type = "Recording | SpectrumInput | Signal")] recording: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "IdentifyOptions | null")] options: JsValue,
+) -> Result<JsValue, JsValue> {
     if !(options.is_undefined() || options.is_null() || options.is_object()) {
         return Err(js_error(Error::Parse {
             field: "options".into(),
@@ -504,11 +516,11 @@ fn identification_to_js(
 /// table (Klipper's own pick among them), with `note` saying what it bought. In the
 /// measured-data worker's module (js-recording).
 #[cfg(feature = "js-recording")]
-#[wasm_bindgen(js_name = recommendShaper)]
+#[wasm_bindgen(js_name = recommendShaper, unchecked_return_type = "Recommendation")]
 pub fn recommend_shaper(
-    spectrum: JsValue,
-    modes: JsValue,
-    options: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "SpectrumInput")] spectrum: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "MeasuredMode[] | null")] modes: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "RecommendOptions | null")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
     let spectrum = measured_spectrum(&spectrum).map_err(js_error)?;
     let modes: Vec<MeasuredMode> = if modes.is_undefined() || modes.is_null() {
@@ -589,8 +601,8 @@ struct DrawOptions {
 #[wasm_bindgen(js_name = drawSpectrum)]
 pub fn draw_spectrum(
     #[wasm_bindgen(unchecked_param_type = "HTMLCanvasElement")] canvas: JsValue,
-    spectrum: JsValue,
-    options: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "SpectrumInput")] spectrum: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "DrawSpectrumOptions | null")] options: JsValue,
 ) -> Result<(), JsValue> {
     let canvas = args::canvas(canvas, "canvas").map_err(js_error)?;
     let f = f64_vec(&get(&spectrum, "frequencyHz"), "spectrum.frequencyHz").map_err(js_error)?;
@@ -667,8 +679,8 @@ struct KlipperDrawOptions {
 #[wasm_bindgen(js_name = drawKlipperChart)]
 pub fn draw_klipper_chart(
     #[wasm_bindgen(unchecked_param_type = "HTMLCanvasElement")] canvas: JsValue,
-    data: JsValue,
-    options: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "KlipperChartData")] data: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "KlipperChartOptions | null")] options: JsValue,
 ) -> Result<(), JsValue> {
     let canvas = args::canvas(canvas, "canvas").map_err(js_error)?;
     let vec = |key: &str| f64_vec(&get(&data, key), key).map_err(js_error);
@@ -731,8 +743,10 @@ pub fn draw_klipper_chart(
 /// [`crate::export::firmware::AxisShaper`]). A shaper the firmware cannot express is an error
 /// naming the field and the firmware's limit. In the measured-data worker's module.
 #[cfg(feature = "js-recording")]
-#[wasm_bindgen(js_name = firmwareConfig)]
-pub fn firmware_config_js(request: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(js_name = firmwareConfig, unchecked_return_type = "FirmwareConfig")]
+pub fn firmware_config_js(
+    #[wasm_bindgen(unchecked_param_type = "FirmwareConfigRequest")] request: JsValue,
+) -> Result<JsValue, JsValue> {
     use crate::export::firmware::{firmware_config, AxisShaper, Firmware};
     #[derive(Deserialize)]
     struct Request {

@@ -29,3 +29,13 @@ pub use api::*;
 pub use measure::*;
 #[cfg(feature = "js-playground")]
 pub use playground::render_playground;
+
+// The TypeScript types the exports' signatures name (`unchecked_param_type`,
+// `unchecked_return_type`), appended to the `.d.ts` of every module: the hand-written ones of
+// the arguments and results, and the family specs generated from the family table
+// (`tests/families.rs` checks `families.d.ts` against `FAMILIES`). A custom section of the
+// compiled module that wasm-bindgen removes: the shipped wasm is the same.
+#[wasm_bindgen::prelude::wasm_bindgen(typescript_custom_section)]
+const TYPES: &str = include_str!("types.d.ts");
+#[wasm_bindgen::prelude::wasm_bindgen(typescript_custom_section)]
+const FAMILY_SPECS: &str = include_str!("families.d.ts");

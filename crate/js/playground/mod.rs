@@ -81,8 +81,11 @@ struct PlaygroundResult {
 /// (`shapers[1].vtol`, `modes[0].damping`, `view.vtol`, `view.mismatch`,
 /// `view.command.maxVelocity`). Nothing is drawn unless everything computed, so a bad input
 /// leaves the last good charts on screen.
-#[wasm_bindgen(js_name = renderPlayground)]
-pub fn render_playground(state: JsValue, canvases: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(js_name = renderPlayground, unchecked_return_type = "PlaygroundResult")]
+pub fn render_playground(
+    #[wasm_bindgen(unchecked_param_type = "PlaygroundState")] state: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "PlaygroundCanvases | null")] canvases: JsValue,
+) -> Result<JsValue, JsValue> {
     frame(state, &canvases)
         .map_err(js_error)
         .and_then(|r| to_js(&r))
