@@ -229,9 +229,10 @@ pub struct ShaperFigures {
 }
 
 /// A run prepared for scoring: the bins ≤ max_freq of the fitted channel, the threshold and
-/// the denominator of R.
-struct Prepared<'a> {
-    psd: &'a [f64],
+/// the denominator of R. The optimised shapers (`super::super::optimal`) score their
+/// candidates with it too ([`Prepared::from_bins`], one per run and frequency factor).
+pub(crate) struct Prepared {
+    psd: Vec<f64>,
     threshold: f64,
     all: f64,
     /// ω of each bin, rad/s.
@@ -251,8 +252,8 @@ struct Prepared<'a> {
 /// printed to 0.1 Hz, as Klipper's files have them, two).
 const MAX_STEPS: usize = 8;
 
-impl<'a> Prepared<'a> {
-    fn new(d: &'a Dataset, channel: Channel, max_freq: f64, tests: &[f64]) -> Result<Self> {
+impl Prepared {
+    fn new(d: &Dataset, channel: Channel, max_freq: f64, tests: &[f64]) -> Result<Self> {
         let psd_all = d.psd(channel).ok_or_else(|| {
             Error::invalid(
                 "channel",
@@ -267,16 +268,24 @@ impl<'a> Prepared<'a> {
             ));
         }
         let psd = &psd_all[..n];
-        let p_max = psd.iter().copied().fold(0.0, f64::max);
-        if p_max <= 0.0 {
+        if psd.iter().copied().fold(0.0, f64::max) <= 0.0 {
             return Err(Error::invalid(
                 "psd",
                 format!("run '{}' is zero at every bin up to {max_freq} Hz", d.name),
             ));
         }
+        Ok(Self::from_bins(&d.freq_bins[..n], psd, 1.0, tests))
+    }
+
+    /// A run of bins `freq` (Hz, increasing) and PSD `psd` (same length, not all zero),
+    /// scored at the test damping ratios `tests` with every bin's ω scaled by `factor`
+    /// (ω = 2π·f·factor, the operations of [`crate::measure::recommend::remaining_vibration`],
+    /// so factor 1 gives Klipper's bins to the bit).
+    pub(crate) fn from_bins(freq: &[f64], psd: &[f64], factor: f64, tests: &[f64]) -> Self {
+        let p_max = psd.iter().copied().fold(0.0, f64::max);
         let threshold = p_max / shapers::SHAPER_VIBRATION_REDUCTION;
         let all = psd.iter().map(|&p| (p - threshold).max(0.0)).sum();
-        let omega: Vec<f64> = d.freq_bins[..n].iter().map(|&f| 2.0 * PI * f).collect();
+        let omega: Vec<f64> = freq.iter().map(|&f| 2.0 * PI * f * factor).collect();
         let rates = tests
             .iter()
             .map(|&z| {
@@ -288,8 +297,8 @@ impl<'a> Prepared<'a> {
             })
             .collect();
         let (steps, step_of) = bin_steps(&omega);
-        Ok(Prepared {
-            psd,
+        Prepared {
+            psd: psd.to_vec(),
             threshold,
             all,
             omega,
@@ -297,12 +306,12 @@ impl<'a> Prepared<'a> {
             rates,
             steps,
             step_of,
-        })
+        }
     }
 
     /// R of `shaper` at the `t`-th test damping ratio (bins that cannot contribute skipped;
     /// see the module docs).
-    fn remaining(&self, shaper: &Shaper, t: usize) -> f64 {
+    pub(crate) fn remaining(&self, shaper: &Shaper, t: usize) -> f64 {
         let imp = shaper.impulses();
         let d = shaper.amplitude_sum();
         let bound = imp.iter().map(|i| i.amplitude.abs()).sum::<f64>() / d.abs();
@@ -545,12 +554,12 @@ fn test_freqs(def: &shapers::KlipperShaperDef, freqs: Option<&ShaperFreqs>) -> R
 }
 
 /// Runs prepared at `max_freq`, and the curve's grid (Klipper's `shaper_freq_bins`).
-fn prepare<'a>(
-    data: &'a CalibrationData,
+fn prepare(
+    data: &CalibrationData,
     channel: Channel,
     max_freq: f64,
     tests: &[f64],
-) -> Result<(Vec<Prepared<'a>>, Vec<f64>)> {
+) -> Result<(Vec<Prepared>, Vec<f64>)> {
     let runs = data
         .datasets()
         .iter()
