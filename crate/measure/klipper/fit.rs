@@ -825,3 +825,61 @@ pub fn find_best_shaper(data: &CalibrationData, options: &FitOptions) -> Result<
         max_freq,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Prepared;
+    use crate::measure::recommend::remaining_vibration;
+    use crate::shaper::{Impulse, Shaper};
+
+    /// The optimised shapers' scorer (`optimal.rs`) takes R from [`Prepared::from_bins`] at
+    /// frequency factors other than 1 (the modes' frequency band): it must be the R of
+    /// `remaining_vibration` (V by `vibration_rad` bin by bin, independent of the chain) at
+    /// f·factor, for positive shapers and for one with a negative impulse, on bins printed to
+    /// 0.1 Hz as Klipper's files have them (two bin steps, so the chain runs).
+    #[test]
+    fn prepared_bins_at_a_frequency_factor_match_the_direct_remaining_vibration() {
+        let freq: Vec<f64> = (0..194)
+            .map(|k| (k as f64 * 1.5625 * 10.0).round() / 10.0)
+            .collect();
+        // Two resonances and a floor: many bins above Klipper's threshold, some below.
+        let psd: Vec<f64> = freq
+            .iter()
+            .map(|&f| {
+                let peak = |f0: f64, w: f64| 1.0 / (1.0 + ((f - f0) / w).powi(2));
+                0.002 + peak(47.0, 4.0) + 0.6 * peak(83.0, 6.0)
+            })
+            .collect();
+        let imp = |time: f64, amplitude: f64| Impulse { time, amplitude };
+        let shapers = [
+            Shaper::new(vec![imp(0.0, 0.3), imp(0.0104, 0.45), imp(0.0211, 0.25)]).unwrap(),
+            Shaper::new(vec![
+                imp(0.0, 0.18),
+                imp(0.006, 0.3),
+                imp(0.0133, 0.27),
+                imp(0.019, 0.2),
+                imp(0.031, 0.05),
+            ])
+            .unwrap(),
+            Shaper::new(vec![imp(0.0, 0.7), imp(0.008, -0.2), imp(0.016, 0.5)]).unwrap(),
+        ];
+        let tests = [0.05, 0.1, 0.15];
+        let mut chained_any = false;
+        for factor in [0.93, 1.0, 1.06] {
+            let prepared = Prepared::from_bins(&freq, &psd, factor, &tests);
+            chained_any |= !prepared.steps.is_empty();
+            for shaper in &shapers {
+                for (t, &zeta) in tests.iter().enumerate() {
+                    let direct = remaining_vibration(shaper, &freq, &psd, zeta, factor);
+                    let chained = prepared.remaining(shaper, t);
+                    assert!(direct > 1e-4, "a case that leaves vibration: {direct}");
+                    assert!(
+                        (chained - direct).abs() <= 1e-12 * direct,
+                        "factor {factor}, ζ {zeta}: chained {chained} vs direct {direct}"
+                    );
+                }
+            }
+        }
+        assert!(chained_any, "the bins must take the chained path");
+    }
+}
