@@ -1,9 +1,9 @@
 """Times benches/reference/klipper_reference.py's fit (numpy, calibrate_shaper.py's algorithm)
 on the files benches/klipper.rs and benches/klipper_wasm.mjs time: the numpy side of the
-comparison in docs/measured-data.md. Median and minimum of 5 runs after 1 warm-up, the file
-read and normalised once outside the timing (as in the Rust and wasm figures).
+comparison in docs/measured-data.md. Median and minimum of 5 runs (RUNS=n: n) after 1 warm-up,
+the file read and normalised once outside the timing (as in the Rust and wasm figures).
 
-    python3 benches/klipper_numpy_time.py [files…]
+    [RUNS=n] python3 benches/klipper_numpy_time.py [files…]
 """
 import os
 import sys
@@ -18,7 +18,7 @@ files = sys.argv[1:] or ["resonances_x_m1.csv", "resonances_x_z018f61.csv",
 for name in files:
     datasets = ref.parse_file(os.path.join(here, "..", "tests", "data", "klipper", name))
     times = []
-    for i in range(6):
+    for i in range(1 + int(os.environ.get("RUNS", "5"))):
         t0 = time.perf_counter()
         out = ref.best_shaper(datasets)
         if i:

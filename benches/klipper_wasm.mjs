@@ -9,8 +9,8 @@
 //                           # issue 25: the optimised shapers (Klipper's pick, best mainline,
 //                           # best custom: the page's continuation), per axis
 //
-// Prints, per file, the median and minimum of 20 runs after 3 warm-ups (wall clock and the
-// process's CPU time, which a busy machine inflates less), and the pick.
+// Prints, per file, the median and minimum of 20 runs (RUNS=n: n) after 3 warm-ups (wall clock
+// and the process's CPU time, which a busy machine inflates less), and the pick.
 import { readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import path from 'node:path';
@@ -24,6 +24,7 @@ const files = args.length > 1 ? args.slice(1) : [
 ];
 const criterion = process.env.CRITERION ?? 'klipper';
 const firmware = process.env.FIRMWARE ?? 'klipper';
+const RUNS = Number(process.env.RUNS ?? 20);
 const mod = await import(modulePath);
 const wasm = readFileSync(modulePath.replace(/\.js$/, '_bg.wasm'));
 await mod.default({ module_or_path: wasm });
@@ -49,7 +50,7 @@ for (const name of files) {
   const times = [];
   const cpu = [];
   let r;
-  for (let i = 0; i < 20; i++) {
+  for (let i = 0; i < RUNS; i++) {
     const t0 = performance.now();
     const c0 = process.cpuUsage();
     r = run();
@@ -62,7 +63,8 @@ for (const name of files) {
   const pick = criterion === 'optimal'
     ? `${r.ranked[0].label}, score ${r.ranked[0].klipperScore.toPrecision(4)}`
     : (({ name, printed }) => `${name} @ ${printed.freq} Hz`)(r.klipper.families[r.klipper.best]);
-  console.log(`${name}: median ${times[10].toFixed(1)} ms, min ${times[0].toFixed(1)} ms `
-    + `(CPU time: median ${cpu[10].toFixed(1)} ms, min ${cpu[0].toFixed(1)} ms) `
+  const mid = Math.floor(RUNS / 2);
+  console.log(`${name}: median ${times[mid].toFixed(1)} ms, min ${times[0].toFixed(1)} ms `
+    + `(CPU time: median ${cpu[mid].toFixed(1)} ms, min ${cpu[0].toFixed(1)} ms) `
     + `(${spectrum.frequencyHz.length} bins) → ${pick}`);
 }

@@ -4,7 +4,7 @@
 #
 # Each wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
 # library with the crate (-Z build-std) at the module's opt-level ("z", or 2 for the page's
-# main thread; below) and LTO, with panic locations left out (-Z location-detail=none; panic
+# main thread and its measured-data worker; below) and LTO, with panic locations left out (-Z location-detail=none; panic
 # messages stay): same code, same results, ~24 KB less gzip (docs/page-performance.md, *Shipped size*). std's
 # `optimize_for_size` feature would save 7 KB more, but it formats floats (every tick label)
 # with Dragon4 only, not Grisu. Without that toolchain (setup could not install it), or with
@@ -47,7 +47,13 @@ fi
 # (~17 %, 8 paired runs) and faster again at 2 (5 paired runs), for 17 + 40 KB more gzip:
 # the first load is ~5 KB under its 300 KB budget (docs/page-performance.md, *Optimisation
 # level*; `shrink … s` and `build_module … s` below give back the 40 KB). Rust's optimisation
-# levels do not change floating-point results. The other modules stay at "z".
+# levels do not change floating-point results. The measured-data worker's module (recording) is
+# built for speed too (opt-level 2, `wasm-opt -O2`): it is fetched only when a recording is
+# opened, outside the first-load budget, and issue 25's optimised shaper must stay under 500 ms
+# per axis in that worker. Measured 2026-12-04 (docs/measured-data.md, *Optimised shapers*,
+# *Speed*): node CPU time per axis about halved against "z" / `-Oz` (resonances_y_three.csv
+# 159 → 79 ms), opt-level 3 / `-O3` no faster, for 66.7 KB more gzip (255.0 → 321.7 KB).
+# The designer module stays at "z".
 # build_module FEATURES OUT_DIR OUT_NAME [OPT_LEVEL]
 build_module() {
   local features=$1 out=$2 name=$3 opt=${4:-z} dir=""
@@ -155,7 +161,7 @@ module js-api pkg input_shaping z z
 if [ "$what" != --library ]; then
   module js-playground pkg/page playground 2 2
   module js-designer,solver pkg/page designer z z
-  module js-recording pkg/page recording z z
+  module js-recording pkg/page recording 2 2
 fi
 for pid in "${pids[@]+"${pids[@]}"}"; do wait "$pid"; done
 if [ "$what" = --check ]; then exit $((stale > 0)); fi

@@ -56,11 +56,12 @@ use crate::shaper::{Impulse, Shaper, ShaperData};
 use crate::smoothing;
 use serde::{Deserialize, Serialize};
 
+use super::klipper::fit::Prepared;
 use super::klipper::{
     find_best_shaper, klipper_figures_on, klipper_shaper, CalibrationData, Channel, FitOptions,
     KLIPPER_SHAPERS,
 };
-use super::recommend::{remaining_vibration, MeasuredMode, MeasuredSpectrum};
+use super::recommend::{MeasuredMode, MeasuredSpectrum};
 
 #[cfg(feature = "solver")]
 #[path = "optimal_grid.rs"]
@@ -244,21 +245,25 @@ pub struct OptimalReport {
 
 /// The runs as Klipper scores them, with the evaluation sets.
 struct Scorer {
-    /// Per run: the bins with PSD above Klipper's threshold (the others add nothing for a
-    /// shaper with positive amplitudes, whose V ≤ 1), and every bin ≤ 200 Hz.
+    /// Per run: the bins with PSD above Klipper's threshold (the grid program's cones).
+    #[cfg(feature = "solver")]
     runs: Vec<Run>,
     /// (ζ, factor, part of Klipper's own set)
+    #[cfg(feature = "solver")]
     cases: Vec<(f64, f64, bool)>,
+    /// Per run and distinct frequency factor: the bins prepared for Klipper's chained V
+    /// evaluation (`klipper::fit::Prepared`) at that factor's damping ratios, and for each of
+    /// them whether it is one of Klipper's own cases.
+    groups: Vec<(Prepared, Vec<bool>)>,
     scv: f64,
     evaluations: std::cell::Cell<usize>,
 }
 
-/// One run's bins.
+/// One run's bins above Klipper's threshold.
+#[cfg(feature = "solver")]
 struct Run {
     freq: Vec<f64>,
     psd: Vec<f64>,
-    all_freq: Vec<f64>,
-    all_psd: Vec<f64>,
 }
 
 /// Klipper's score from smoothing and R (shaper_calibrate.py `fit_shaper`).
@@ -290,25 +295,6 @@ impl Scorer {
         factors: &[f64],
         scv: f64,
     ) -> Self {
-        let runs = runs
-            .iter()
-            .map(|(freq, psd)| {
-                let p_max = psd.iter().copied().fold(0.0, f64::max);
-                let threshold = p_max / super::recommend::SHAPER_VIBRATION_REDUCTION;
-                let (f_red, p_red): (Vec<f64>, Vec<f64>) = freq
-                    .iter()
-                    .zip(psd)
-                    .filter(|(_, &p)| p > threshold)
-                    .map(|(&f, &p)| (f, p))
-                    .unzip();
-                Run {
-                    freq: f_red,
-                    psd: p_red,
-                    all_freq: freq.clone(),
-                    all_psd: psd.clone(),
-                }
-            })
-            .collect();
         let mut cases: Vec<(f64, f64, bool)> = KLIPPER_TEST_DAMPING
             .iter()
             .map(|&z| (z, 1.0, true))
@@ -323,30 +309,57 @@ impl Scorer {
                 }
             }
         }
+        let mut groups = Vec::new();
+        for (freq, psd) in runs {
+            let mut factors: Vec<f64> = Vec::new();
+            for c in &cases {
+                if !factors.contains(&c.1) {
+                    factors.push(c.1);
+                }
+            }
+            for s in factors {
+                let of_s = cases.iter().filter(|c| c.1 == s);
+                let tests: Vec<f64> = of_s.clone().map(|c| c.0).collect();
+                let own = of_s.map(|c| c.2).collect();
+                groups.push((Prepared::from_bins(freq, psd, s, &tests), own));
+            }
+        }
         Scorer {
-            runs,
+            #[cfg(feature = "solver")]
+            runs: runs
+                .iter()
+                .map(|(freq, psd)| {
+                    let p_max = psd.iter().copied().fold(0.0, f64::max);
+                    let threshold = p_max / super::recommend::SHAPER_VIBRATION_REDUCTION;
+                    let (freq, psd) = freq
+                        .iter()
+                        .zip(psd)
+                        .filter(|(_, &p)| p > threshold)
+                        .map(|(&f, &p)| (f, p))
+                        .unzip();
+                    Run { freq, psd }
+                })
+                .collect(),
+            #[cfg(feature = "solver")]
             cases,
+            groups,
             scv,
             evaluations: std::cell::Cell::new(0),
         }
     }
 
     /// Own and robust R and the smoothing of `shaper`; `robust` false skips the robust cases.
+    /// R is Klipper's ([`Prepared::remaining`]: V chained over the bins, the bins that cannot
+    /// add to R skipped), the largest over the runs and the cases.
     fn eval(&self, shaper: &Shaper, robust: bool) -> Result<Eval> {
         self.evaluations.set(self.evaluations.get() + 1);
-        let positive = shaper.impulses().iter().all(|i| i.amplitude >= 0.0);
         let (mut own_r, mut robust_r) = (0.0_f64, 0.0_f64);
-        for run in &self.runs {
-            let (f, p) = if positive {
-                (&run.freq, &run.psd)
-            } else {
-                (&run.all_freq, &run.all_psd)
-            };
-            for &(z, s, own) in &self.cases {
+        for (prepared, own) in &self.groups {
+            for (t, &own) in own.iter().enumerate() {
                 if !own && !robust {
                     continue;
                 }
-                let r = remaining_vibration(shaper, f, p, z, s);
+                let r = prepared.remaining(shaper, t);
                 if own {
                     own_r = own_r.max(r);
                 }

@@ -229,9 +229,10 @@ pub struct ShaperFigures {
 }
 
 /// A run prepared for scoring: the bins ≤ max_freq of the fitted channel, the threshold and
-/// the denominator of R.
-struct Prepared<'a> {
-    psd: &'a [f64],
+/// the denominator of R. The optimised shapers (`super::super::optimal`) score their
+/// candidates with it too ([`Prepared::from_bins`], one per run and frequency factor).
+pub(crate) struct Prepared {
+    psd: Vec<f64>,
     threshold: f64,
     all: f64,
     /// ω of each bin, rad/s.
@@ -251,8 +252,8 @@ struct Prepared<'a> {
 /// printed to 0.1 Hz, as Klipper's files have them, two).
 const MAX_STEPS: usize = 8;
 
-impl<'a> Prepared<'a> {
-    fn new(d: &'a Dataset, channel: Channel, max_freq: f64, tests: &[f64]) -> Result<Self> {
+impl Prepared {
+    fn new(d: &Dataset, channel: Channel, max_freq: f64, tests: &[f64]) -> Result<Self> {
         let psd_all = d.psd(channel).ok_or_else(|| {
             Error::invalid(
                 "channel",
@@ -267,16 +268,24 @@ impl<'a> Prepared<'a> {
             ));
         }
         let psd = &psd_all[..n];
-        let p_max = psd.iter().copied().fold(0.0, f64::max);
-        if p_max <= 0.0 {
+        if psd.iter().copied().fold(0.0, f64::max) <= 0.0 {
             return Err(Error::invalid(
                 "psd",
                 format!("run '{}' is zero at every bin up to {max_freq} Hz", d.name),
             ));
         }
+        Ok(Self::from_bins(&d.freq_bins[..n], psd, 1.0, tests))
+    }
+
+    /// A run of bins `freq` (Hz, increasing) and PSD `psd` (same length, not all zero),
+    /// scored at the test damping ratios `tests` with every bin's ω scaled by `factor`
+    /// (ω = 2π·f·factor, the operations of [`crate::measure::recommend::remaining_vibration`],
+    /// so factor 1 gives Klipper's bins to the bit).
+    pub(crate) fn from_bins(freq: &[f64], psd: &[f64], factor: f64, tests: &[f64]) -> Self {
+        let p_max = psd.iter().copied().fold(0.0, f64::max);
         let threshold = p_max / shapers::SHAPER_VIBRATION_REDUCTION;
         let all = psd.iter().map(|&p| (p - threshold).max(0.0)).sum();
-        let omega: Vec<f64> = d.freq_bins[..n].iter().map(|&f| 2.0 * PI * f).collect();
+        let omega: Vec<f64> = freq.iter().map(|&f| 2.0 * PI * f * factor).collect();
         let rates = tests
             .iter()
             .map(|&z| {
@@ -288,8 +297,8 @@ impl<'a> Prepared<'a> {
             })
             .collect();
         let (steps, step_of) = bin_steps(&omega);
-        Ok(Prepared {
-            psd,
+        Prepared {
+            psd: psd.to_vec(),
             threshold,
             all,
             omega,
@@ -297,12 +306,12 @@ impl<'a> Prepared<'a> {
             rates,
             steps,
             step_of,
-        })
+        }
     }
 
     /// R of `shaper` at the `t`-th test damping ratio (bins that cannot contribute skipped;
     /// see the module docs).
-    fn remaining(&self, shaper: &Shaper, t: usize) -> f64 {
+    pub(crate) fn remaining(&self, shaper: &Shaper, t: usize) -> f64 {
         let imp = shaper.impulses();
         let d = shaper.amplitude_sum();
         let bound = imp.iter().map(|i| i.amplitude.abs()).sum::<f64>() / d.abs();
@@ -377,7 +386,12 @@ impl<'a> Prepared<'a> {
             }
             if active(k) {
                 let (c, s) = e.iter().fold((0.0, 0.0), |(c, s), &(a, b)| (c + a, s + b));
-                add(k, c.hypot(s));
+                // √(c² + s²), not `hypot`: wasm has no fused multiply-add and the libm `hypot`
+                // Rust links there emulates one in software, which took over half of the
+                // optimised shapers' time in the page's module (a node CPU profile of
+                // resonances_y_three.csv). |c|, |s| ≤ Σ|Aᵢ| here, so nothing overflows, and the
+                // two differ by an ulp or so, far below the chain's own 10⁻¹³.
+                add(k, (c * c + s * s).sqrt());
             }
         }
     }
@@ -545,12 +559,12 @@ fn test_freqs(def: &shapers::KlipperShaperDef, freqs: Option<&ShaperFreqs>) -> R
 }
 
 /// Runs prepared at `max_freq`, and the curve's grid (Klipper's `shaper_freq_bins`).
-fn prepare<'a>(
-    data: &'a CalibrationData,
+fn prepare(
+    data: &CalibrationData,
     channel: Channel,
     max_freq: f64,
     tests: &[f64],
-) -> Result<(Vec<Prepared<'a>>, Vec<f64>)> {
+) -> Result<(Vec<Prepared>, Vec<f64>)> {
     let runs = data
         .datasets()
         .iter()
@@ -810,4 +824,62 @@ pub fn find_best_shaper(data: &CalibrationData, options: &FitOptions) -> Result<
         test_damping_ratios: tests,
         max_freq,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Prepared;
+    use crate::measure::recommend::remaining_vibration;
+    use crate::shaper::{Impulse, Shaper};
+
+    /// The optimised shapers' scorer (`optimal.rs`) takes R from [`Prepared::from_bins`] at
+    /// frequency factors other than 1 (the modes' frequency band): it must be the R of
+    /// `remaining_vibration` (V by `vibration_rad` bin by bin, independent of the chain) at
+    /// f·factor, for positive shapers and for one with a negative impulse, on bins printed to
+    /// 0.1 Hz as Klipper's files have them (two bin steps, so the chain runs).
+    #[test]
+    fn prepared_bins_at_a_frequency_factor_match_the_direct_remaining_vibration() {
+        let freq: Vec<f64> = (0..194)
+            .map(|k| (k as f64 * 1.5625 * 10.0).round() / 10.0)
+            .collect();
+        // Two resonances and a floor: many bins above Klipper's threshold, some below.
+        let psd: Vec<f64> = freq
+            .iter()
+            .map(|&f| {
+                let peak = |f0: f64, w: f64| 1.0 / (1.0 + ((f - f0) / w).powi(2));
+                0.002 + peak(47.0, 4.0) + 0.6 * peak(83.0, 6.0)
+            })
+            .collect();
+        let imp = |time: f64, amplitude: f64| Impulse { time, amplitude };
+        let shapers = [
+            Shaper::new(vec![imp(0.0, 0.3), imp(0.0104, 0.45), imp(0.0211, 0.25)]).unwrap(),
+            Shaper::new(vec![
+                imp(0.0, 0.18),
+                imp(0.006, 0.3),
+                imp(0.0133, 0.27),
+                imp(0.019, 0.2),
+                imp(0.031, 0.05),
+            ])
+            .unwrap(),
+            Shaper::new(vec![imp(0.0, 0.7), imp(0.008, -0.2), imp(0.016, 0.5)]).unwrap(),
+        ];
+        let tests = [0.05, 0.1, 0.15];
+        let mut chained_any = false;
+        for factor in [0.93, 1.0, 1.06] {
+            let prepared = Prepared::from_bins(&freq, &psd, factor, &tests);
+            chained_any |= !prepared.steps.is_empty();
+            for shaper in &shapers {
+                for (t, &zeta) in tests.iter().enumerate() {
+                    let direct = remaining_vibration(shaper, &freq, &psd, zeta, factor);
+                    let chained = prepared.remaining(shaper, t);
+                    assert!(direct > 1e-4, "a case that leaves vibration: {direct}");
+                    assert!(
+                        (chained - direct).abs() <= 1e-12 * direct,
+                        "factor {factor}, ζ {zeta}: chained {chained} vs direct {direct}"
+                    );
+                }
+            }
+        }
+        assert!(chained_any, "the bins must take the chained path");
+    }
 }
