@@ -80,6 +80,40 @@ fn calibration_file_has_shapers_and_is_normalised() {
     assert_eq!(s.psd_sum, vec![0.0, 3.0, 4.0]);
 }
 
+/// Klipper's releases of 2021–2023 wrote calibration files without the `shapers:` marker
+/// (`freq,psd_x,psd_y,psd_z,psd_xyz,zv(44.0),mzv(43.4),…`, shaper columns on the PSD's rows;
+/// public files of that layout were read as resonances files, the shapers lost in `extra`).
+/// A fork's extra column (`accel_per_hz`) before them stays an extra column.
+#[wasm_bindgen_test(unsupported = test)]
+fn calibration_file_without_the_shapers_marker_is_a_calibration_file() {
+    let text = "freq,psd_x,psd_y,psd_z,psd_xyz,zv(44.0),mzv(43.4)\n\
+0.0,0.000e+00,0.000e+00,0.000e+00,0.000e+00,1.000,1.000\n\
+1.5,1.000e+00,1.000e+00,1.000e+00,3.000e+00,0.994,0.991\n\
+3.0,2.000e+00,1.000e+00,1.000e+00,4.000e+00,0.985,0.979\n";
+    let s = spectrum(text, "calibration_data_y_20230306_225431.csv");
+    assert_eq!(s.format, RecordingFormat::KlipperCalibration);
+    assert_eq!(s.normalization, Normalization::Klipper);
+    assert!(s.extra.is_empty());
+    assert_eq!(s.shapers.len(), 2);
+    assert_eq!(s.shapers[0].name, "zv");
+    assert_eq!(s.shapers[1].frequency_hz, 43.4);
+    assert_eq!(s.shapers[1].values, vec![1.0, 0.991, 0.979]);
+    assert_eq!(s.psd_sum, vec![0.0, 3.0, 4.0]);
+    let fork = "freq,psd_x,psd_y,psd_z,psd_xyz,accel_per_hz,zv(44.0)\n\
+0.0,0,0,0,0,60,1.000\n1.5,1,1,1,3,60,0.994\n";
+    let s = spectrum(fork, "calibration_data_x_a.csv");
+    assert_eq!(s.format, RecordingFormat::KlipperCalibration);
+    assert_eq!(s.extra.len(), 1);
+    assert_eq!(s.extra[0].name, "accel_per_hz");
+    assert_eq!(s.shapers[0].values, vec![1.0, 0.994]);
+    // A resonances file with a fork's column only is not a calibration file.
+    let plain = "freq,psd_x,psd_y,psd_z,psd_xyz,accel_per_hz\n0.0,0,0,0,0,60\n1.5,1,1,1,3,60\n";
+    let s = spectrum(plain, "resonances_x_a.csv");
+    assert_eq!(s.format, RecordingFormat::KlipperResonances);
+    assert_eq!(s.normalization, Normalization::None);
+    assert!(s.shapers.is_empty());
+}
+
 #[wasm_bindgen_test(unsupported = test)]
 fn a_file_of_several_runs_keeps_them_and_averages_the_sum() {
     let text = "freq,run_a.csv,run_b.csv,shapers:,zv(40.0)\n0.0,1.0,3.0,,1.0\n1.6,2.0,4.0,,0.9\n";

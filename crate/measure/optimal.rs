@@ -1001,11 +1001,39 @@ fn own_figures(shaper: &Shaper, data: &CalibrationData, scv: f64) -> Result<Figu
     })
 }
 
-/// The robust score's damping ratios (Klipper's three, and ζ − kσ, ζ, ζ + kσ of every mode,
-/// sorted, deduplicated) and frequency factors (for the mainline search: 1 ± kσ_f/f when the
-/// modes carry a frequency uncertainty, else 1 alone; for the custom search: the same band,
-/// at least [`DEFAULT_FREQUENCY_BAND`]). Errors name the bad mode (`modes[i]…`).
-fn robust_sets(modes: &[MeasuredMode], k: f64) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+/// Whether a mode can contribute to Klipper's remaining vibration R on `runs` (the PSDs
+/// Klipper scores): R sums max(V·P − P_max/20, 0) over the bins, so a bin whose P is at most
+/// P_max/20 adds 0 whatever V is (V ≤ 1 for positive impulses). A mode counts when a bin
+/// within its half-power band f·(1 ± ζ), widened to at least one bin each side, stands above
+/// that threshold in some run. A weak mode (a small peak on a real spectrum, often fitted with
+/// a wide uncertainty) cannot change R, so its uncertainty must not widen the robust score.
+fn mode_reaches_threshold(runs: &[(Vec<f64>, Vec<f64>)], m: &MeasuredMode) -> bool {
+    runs.iter().any(|(freq, psd)| {
+        let p_max = psd.iter().copied().fold(0.0, f64::max);
+        let threshold = p_max / super::recommend::SHAPER_VIBRATION_REDUCTION;
+        let step = if freq.len() > 1 {
+            (freq[freq.len() - 1] - freq[0]) / (freq.len() - 1) as f64
+        } else {
+            0.0
+        };
+        let half = (m.damping * m.frequency_hz).max(step);
+        freq.iter()
+            .zip(psd)
+            .any(|(&f, &p)| (f - m.frequency_hz).abs() <= half && p > threshold)
+    })
+}
+
+/// The robust score's damping ratios (Klipper's three, and ζ − kσ, ζ, ζ + kσ of every mode
+/// that can contribute to R on `runs` ([`mode_reaches_threshold`]), sorted, deduplicated) and
+/// frequency factors (for the mainline search: 1 ± kσ_f/f of those modes when they carry a
+/// frequency uncertainty, else 1 alone; for the custom search: the same band, at least
+/// [`DEFAULT_FREQUENCY_BAND`]). Every mode is validated; errors name the bad mode
+/// (`modes[i]…`).
+fn robust_sets(
+    modes: &[MeasuredMode],
+    k: f64,
+    runs: &[(Vec<f64>, Vec<f64>)],
+) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
     count("modes", modes.len(), 0, super::identify::MAX_MODES)?;
     let mut damping: Vec<f64> = KLIPPER_TEST_DAMPING.to_vec();
     let mut rel_f: f64 = 0.0;
@@ -1014,6 +1042,9 @@ fn robust_sets(modes: &[MeasuredMode], k: f64) -> Result<(Vec<f64>, Vec<f64>, Ve
         crate::mode::Mode::new(m.frequency_hz, m.damping).map_err(at)?;
         finite("frequencyUncertaintyHz", m.frequency_uncertainty_hz).map_err(at)?;
         finite("dampingUncertainty", m.damping_uncertainty).map_err(at)?;
+        if !mode_reaches_threshold(runs, m) {
+            continue;
+        }
         let s = k * m.damping_uncertainty.abs();
         for z in [m.damping - s, m.damping, m.damping + s] {
             damping.push(z.clamp(0.0, 0.95));
@@ -1105,7 +1136,7 @@ pub fn optimal(
         ));
     }
     finite("scv", options.scv)?;
-    let (damping, mainline_factors, custom_factors) = robust_sets(modes, k)?;
+    let (damping, mainline_factors, custom_factors) = robust_sets(modes, k, &runs)?;
 
     let scorer = Scorer::new(&runs, &damping, &mainline_factors, options.scv);
     let pick = klipper_pick(&scorer, data, options.scv)?;

@@ -252,6 +252,20 @@ struct Header {
     spectrum: Option<SpectrumLayout>,
 }
 
+/// A shaper column's name and frequency: `zv(59.8)` (`save_calibration_data` writes
+/// `%s(%.1f)`); `None` for any other column name.
+fn shaper_label(name: &str) -> Option<(String, f64)> {
+    name.strip_suffix(')')
+        .and_then(|s| s.split_once('('))
+        .filter(|(a, _)| !a.is_empty())
+        .and_then(|(a, f)| {
+            f.parse::<f64>()
+                .ok()
+                .filter(|f| f.is_finite())
+                .map(|f| (a.to_string(), f))
+        })
+}
+
 /// Where the columns of a Klipper spectrum file are.
 #[derive(Debug, Clone)]
 struct SpectrumLayout {
@@ -644,7 +658,21 @@ impl RecordingParser {
         let marker = names.iter().position(|s| s == "shapers:");
         let runs = names.get(1).map(String::as_str) != Some("psd_x");
         let first_extra = if runs { 1 } else { 5 };
-        let extra: Vec<usize> = (first_extra..marker.unwrap_or(names.len())).collect();
+        // Klipper's releases before the `shapers:` marker (2021–2023, `save_calibration_data`
+        // writing `freq,psd_x,psd_y,psd_z,psd_xyz,zv(61.6),mzv(62.6),…`): the trailing columns
+        // named `<shaper>(<frequency>)` are the fitted shapers, on the PSD's own rows.
+        let unmarked = if marker.is_none() && !runs {
+            let tail = names[first_extra.min(names.len())..]
+                .iter()
+                .rev()
+                .take_while(|s| shaper_label(s).is_some())
+                .count();
+            (tail > 0).then(|| names.len() - tail)
+        } else {
+            None
+        };
+        let end = marker.or(unmarked).unwrap_or(names.len());
+        let extra: Vec<usize> = (first_extra..end).collect();
         if runs && extra.is_empty() {
             return Err(RecordingError::at(
                 n,
@@ -652,19 +680,9 @@ impl RecordingParser {
             ));
         }
         let mut shapers = Vec::new();
-        if let Some(m) = marker {
-            for (j, name) in names.iter().enumerate().skip(m + 1) {
-                // `zv(59.8)`: name and frequency (`save_calibration_data` writes `%s(%.1f)`).
-                let parsed = name
-                    .strip_suffix(')')
-                    .and_then(|s| s.split_once('('))
-                    .and_then(|(a, f)| {
-                        f.parse::<f64>()
-                            .ok()
-                            .filter(|f| f.is_finite())
-                            .map(|f| (a.to_string(), f))
-                    });
-                let Some((shaper, freq)) = parsed else {
+        if let Some(first) = marker.map(|m| m + 1).or(unmarked) {
+            for (j, name) in names.iter().enumerate().skip(first) {
+                let Some((shaper, freq)) = shaper_label(name) else {
                     return Err(RecordingError::field(
                         n,
                         j + 1,
@@ -880,7 +898,7 @@ impl RecordingParser {
         };
         let sources = runs.len().max(1);
         let file = SpectrumFile {
-            format: if layout.marker.is_some() {
+            format: if layout.marker.is_some() || !layout.shapers.is_empty() {
                 RecordingFormat::KlipperCalibration
             } else {
                 RecordingFormat::KlipperResonances
