@@ -17,20 +17,8 @@ use nalgebra::{Matrix2, Vector2};
 use std::f64::consts::PI;
 use wasm_bindgen_test::wasm_bindgen_test;
 
-/// xorshift64* and Box–Muller: deterministic noise without a dependency.
-struct Rng(u64);
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        let (u, v) = (self.uniform(), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (2.0 * PI * v).cos()
-    }
-}
+mod common;
+use common::Rng;
 
 /// Acceleration of Σ modes (f Hz, ζ, gain) driven by one white force held over steps of
 /// 1/(4·fs): q'' + 2ζωq' + ω²q = g·u, integrated exactly (matrix exponential), read as an

@@ -16,6 +16,8 @@ use input_shaping::measure::recording::{parse_file, Parsed, RecordingOptions};
 use input_shaping::measure::spectrum_file::combine_spectra;
 use serde_json::Value;
 use std::path::Path;
+mod common;
+use common::Rng;
 
 const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/klipper");
 
@@ -273,22 +275,10 @@ fn every_case_of_the_independent_test_set() {
     }
 }
 
-/// xorshift64*: deterministic noise without a dependency.
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    /// Gamma(k, 1/k): a Welch estimate's ratio to its expectation, k independent segments
-    /// (the mean of k unit exponentials).
-    fn welch_ratio(&mut self, k: usize) -> f64 {
-        (0..k).map(|_| -self.uniform().ln()).sum::<f64>() / k as f64
-    }
+/// Gamma(k, 1/k): a Welch estimate's ratio to its expectation, k independent segments (the
+/// mean of k unit exponentials).
+fn welch_ratio(rng: &mut Rng, k: usize) -> f64 {
+    (0..k).map(|_| -rng.uniform().ln()).sum::<f64>() / k as f64
 }
 
 /// I₀ by its series (Kaiser's window).
@@ -354,8 +344,8 @@ fn synthetic_resonances(modes: &[(f64, f64, f64)], floor: f64, k: usize, rng: &m
             .zip(&kern)
             .map(|(nu, c)| c * true_psd(f + nu * df))
             .sum();
-        let x = expected * rng.welch_ratio(k);
-        let (y, z) = (floor * rng.welch_ratio(k), floor * rng.welch_ratio(k));
+        let x = expected * welch_ratio(rng, k);
+        let (y, z) = (floor * welch_ratio(rng, k), floor * welch_ratio(rng, k));
         text.push_str(&format!(
             "{f:.1},{x:.3e},{y:.3e},{z:.3e},{:.3e}\n",
             x + y + z

@@ -44,3 +44,23 @@ pub fn kamel_spec() -> input_shaping::design::sampled::SampledSpec {
         ..input_shaping::design::sampled::SampledSpec::new(0.012, 36)
     }
 }
+
+/// xorshift64* and Box–Muller: deterministic noise without a dependency (the same sequence on
+/// every machine and in wasm).
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// Uniform on (0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    /// Standard normal.
+    pub fn normal(&mut self) -> f64 {
+        let (u, v) = (self.uniform(), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+    }
+}
