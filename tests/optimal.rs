@@ -287,6 +287,45 @@ fn measured_modes_bound_the_robust_vibrations_and_klippers_score_ranks() {
     );
 }
 
+/// `customMethod: both` keeps the better of the continuation and the grid program, each run on
+/// its own (`CustomMethod::Both`'s contract). Run as one path sharing the growth and the
+/// evaluation budget, it scored worse than the continuation alone on a real file (bassco
+/// ender3 y with its identified modes: −4.0 % against Klipper's pick vs −8.1 %;
+/// docs/measured-data.md, *On real recordings*); that file is not in the repository and on
+/// this test set the one-path version happens to pass too. Here the grid alone scores below
+/// the continuation alone (0.001475 vs 0.001483), so a `both` that kept the continuation's
+/// result fails.
+#[cfg(feature = "solver")]
+#[test]
+fn both_methods_keep_the_better_custom_shaper() {
+    use input_shaping::measure::optimal::CustomMethod;
+    let data = read("resonances_y_m1.csv");
+    let modes = [MeasuredMode {
+        frequency_hz: 37.6,
+        damping: 0.12,
+        frequency_uncertainty_hz: 0.3,
+        damping_uncertainty: 0.01,
+    }];
+    let score = |method| {
+        let options = OptimalOptions {
+            firmware: Firmware::Reprapfirmware,
+            custom_method: method,
+            ..OptimalOptions::default()
+        };
+        optimal(&data, &modes, &options).unwrap().rows[2]
+            .klipper
+            .score
+    };
+    let both = score(CustomMethod::Both);
+    for method in [CustomMethod::Continuation, CustomMethod::Grid] {
+        let alone = score(method);
+        assert!(
+            both <= alone * (1.0 + 1e-12),
+            "both {both} above {method:?} alone {alone}"
+        );
+    }
+}
+
 /// A mode whose peak stays under Klipper's threshold (P_max/20) cannot change Klipper's R, so
 /// its uncertainty must not widen the robust score: on real spectra a weak second or third peak
 /// is often fitted with a wide uncertainty (118.5 ± 7.5 Hz on a public Voron 2.4 file), and
