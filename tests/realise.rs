@@ -253,9 +253,9 @@ fn rrf_zvd_runs_as_designed() {
     }
 }
 
-/// RRF's EI2 (AxisShaper.cpp, case ei2): its durations sum to (1.49920 − 0.09297ζ − 0.28338ζ²
-/// + 1.85710ζ³) · dampedPeriod, where Klipper divides by f alone; its last amplitude is
-/// 1 − (0.16054 + 0.76699ζ + …) − … (the cumulative coefficients[2]).
+/// RRF's EI2 (AxisShaper.cpp, case ei2): its durations sum to the cubic 1.49920 − 0.09297ζ −
+/// 0.28338ζ² + 1.85710ζ³ times the damped period, where Klipper divides by f alone; its last
+/// amplitude is 1 minus the cumulative `coefficients[2]` = (0.16054 + 0.33911 + 0.34089) + ….
 #[test]
 fn rrf_ei2_scales_the_fit_by_the_damped_period() {
     let (f, z) = (40.0, 0.1);

@@ -47,7 +47,7 @@
 
 pub mod definitions;
 
-use crate::design::quantize::{quantize, QuantizeOptions};
+use crate::design::quantize::{quantize, QuantizeOptions, MAX_AMPLITUDE_STEPS};
 use crate::design::{design_for, DesignRequest, ShaperSpec};
 use crate::error::{positive, Error, Result};
 use crate::firmware_limits::{
@@ -239,8 +239,59 @@ pub struct Realisation {
 /// # Ok::<(), input_shaping::Error>(())
 /// ```
 pub fn realise(request: &DesignRequest, options: &RealiseOptions) -> Result<Realisation> {
+    check_options(options)?;
     let modes = Mode::list(&request.modes)?;
     let ideal = design_for(&request.shaper, &modes)?;
+    realise_designed(request, &modes, ideal, options)
+}
+
+/// The checks of `options` that do not depend on the design: `vtol` in (0, 1), `periodS`
+/// positive, `amplitudeSteps` in 1 … 2²⁴, `maxImpulses` in 1 … [`MAX_IMPULSES_OPTION`]. Errors
+/// name the option.
+pub fn check_options(options: &RealiseOptions) -> Result<()> {
+    crate::vibration::tolerable_vibration(options.vtol)?;
+    if let Some(p) = options.period_s {
+        positive("periodS", p)?;
+    }
+    if let Some(steps) = options.amplitude_steps {
+        if steps == 0 {
+            return Err(Error::invalid(
+                "amplitudeSteps",
+                "must be at least 1, got 0",
+            ));
+        }
+        if steps > MAX_AMPLITUDE_STEPS {
+            return Err(Error::TooLarge {
+                field: "amplitudeSteps".into(),
+                value: f64::from(steps),
+                limit: f64::from(MAX_AMPLITUDE_STEPS),
+            });
+        }
+    }
+    match options.max_impulses {
+        Some(0) => Err(Error::invalid("maxImpulses", "must be at least 1, got 0")),
+        Some(max) if max > MAX_IMPULSES_OPTION => Err(Error::TooLarge {
+            field: "maxImpulses".into(),
+            value: max as f64,
+            limit: MAX_IMPULSES_OPTION as f64,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// [`realise`] of an already designed `ideal` for `request`'s validated `modes` (non-empty).
+/// Every error here comes from the options or the firmware's limits (fields `firmware`,
+/// `periodS`, `amplitudeSteps`, `maxImpulses`).
+pub fn realise_designed(
+    request: &DesignRequest,
+    modes: &[Mode],
+    ideal: Shaper,
+    options: &RealiseOptions,
+) -> Result<Realisation> {
+    check_options(options)?;
+    if modes.is_empty() {
+        return Err(Error::invalid("modes", "at least one mode is needed"));
+    }
     let mut changes = Vec::new();
     let (realised, runs) = match options.firmware {
         Controller::Ideal => (ideal.clone(), request.shaper.name().to_string()),
@@ -251,13 +302,13 @@ pub fn realise(request: &DesignRequest, options: &RealiseOptions) -> Result<Real
         firmware => on_firmware(
             firmware,
             &request.shaper,
-            &modes,
+            modes,
             &ideal,
             options,
             &mut changes,
         )?,
     };
-    report::build(request, &modes, ideal, realised, runs, changes, options)
+    report::build(request, modes, ideal, realised, runs, changes, options)
 }
 
 /// The named family of `spec`, if firmware could run it by name.
@@ -652,16 +703,6 @@ fn marlin_ft(
 fn generic(ideal: &Shaper, options: &RealiseOptions, changes: &mut Vec<Change>) -> Result<Shaper> {
     let mut shaper = ideal.clone();
     if let Some(max) = options.max_impulses {
-        if max == 0 {
-            return Err(Error::invalid("maxImpulses", "must be at least 1, got 0"));
-        }
-        if max > MAX_IMPULSES_OPTION {
-            return Err(Error::TooLarge {
-                field: "maxImpulses".into(),
-                value: max as f64,
-                limit: MAX_IMPULSES_OPTION as f64,
-            });
-        }
         shaper = cap_impulses(&shaper, max, "the controller", changes)?;
     }
     let period = options
