@@ -4,7 +4,9 @@
 mod common;
 
 use common::close;
-use input_shaping::realise::{realise, ChangeKind, Controller, Realisation, RealiseOptions};
+use input_shaping::realise::{
+    realise, ChangeKind, Controller, CurveRange, Realisation, RealiseOptions,
+};
 use input_shaping::{DesignRequest, Error, ModeSpec, ShaperSpec};
 use std::f64::consts::{PI, SQRT_2};
 
@@ -375,4 +377,105 @@ fn prusa_ei_takes_the_designed_tolerance() {
     let req = request(ShaperSpec::Zvdd, &[(50.0, 0.1)]);
     let e = realise(&req, &RealiseOptions::new(Controller::Prusa)).unwrap_err();
     assert_eq!(field(e), "firmware");
+}
+
+/// `curve` asks for both V(f) on one grid; at the mode they are the reported V.
+#[test]
+fn curves_on_request_agree_with_the_mode_figures() {
+    let mut o = RealiseOptions::new(Controller::MarlinFtMotion);
+    o.curve = Some(CurveRange {
+        from_hz: 0.0,
+        to_hz: 120.0,
+        points: 121,
+    });
+    let r = realise(&request(ShaperSpec::Zv, &[(60.0, 0.0)]), &o).unwrap();
+    let (a, b) = (
+        r.sensitivity_ideal.as_ref().unwrap(),
+        r.sensitivity_realised.as_ref().unwrap(),
+    );
+    close(a.frequency_hz[60], 60.0, 1e-12, "grid");
+    close(
+        a.vibration[60],
+        r.modes[0].vibration_ideal,
+        1e-12,
+        "ideal at 60 Hz",
+    );
+    close(
+        b.vibration[60],
+        r.modes[0].vibration_realised,
+        1e-12,
+        "realised at 60 Hz",
+    );
+    o.curve = Some(CurveRange {
+        from_hz: 10.0,
+        to_hz: 5.0,
+        points: 10,
+    });
+    let e = realise(&request(ShaperSpec::Zv, &[(60.0, 0.0)]), &o).unwrap_err();
+    assert!(field(e).starts_with("curve."));
+}
+
+/// The realisation chart (crate::chart::realisation) draws the designed curve as one polyline
+/// and the realised one dashed (many polylines of a few points) in the same colour, with both in the
+/// legend.
+#[test]
+fn realisation_chart_overlays_designed_and_realised() {
+    use input_shaping::chart::{draw_realisation, ChartStyle, SERIES_COLORS};
+    use plotters::prelude::*;
+    let mut o = RealiseOptions::new(Controller::Generic);
+    o.period_s = Some(0.001);
+    o.curve = Some(CurveRange {
+        from_hz: 0.0,
+        to_hz: 150.0,
+        points: 300,
+    });
+    let r = realise(&request(ShaperSpec::Zv, &[(60.0, 0.0)]), &o).unwrap();
+    let (a, b) = (
+        r.sensitivity_ideal.as_ref().unwrap(),
+        r.sensitivity_realised.as_ref().unwrap(),
+    );
+    let mut out = String::new();
+    {
+        let area = SVGBackend::with_string(&mut out, (640, 360)).into_drawing_area();
+        draw_realisation(
+            &area,
+            &[("ZV", a, b)],
+            Some(0.05),
+            &[60.0],
+            &ChartStyle::default(),
+        )
+        .unwrap();
+    }
+    let c = SERIES_COLORS[0];
+    let hex = format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
+    let in_colour: Vec<usize> = out
+        .split("<polyline")
+        .skip(1)
+        .filter(|p| p.contains(&hex))
+        .map(|p| {
+            p.split("points=\"")
+                .nth(1)
+                .and_then(|r| r.split('"').next())
+                .map_or(0, |pts| pts.split(' ').count())
+        })
+        .collect();
+    assert!(
+        in_colour.iter().any(|&n| n >= 300),
+        "the designed curve whole: {in_colour:?}"
+    );
+    assert!(
+        in_colour.iter().filter(|&&n| n < 10).count() > 20,
+        "dashes: {in_colour:?}"
+    );
+    for want in [
+        "ZV",
+        "ZV, realised",
+        "Vtol 5.000 %",
+        "V(f) designed and as run",
+    ] {
+        assert!(
+            out.contains(&format!(">{want}<")) || out.contains(want),
+            "{want} missing"
+        );
+    }
 }

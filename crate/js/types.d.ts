@@ -236,6 +236,8 @@ export interface RealizeOptions {
   /** Generic controller: most impulses, 1 … 10000. */
   maxImpulses?: number | null;
   vtol?: number;
+  /** V(f) of both shapers over this range, at the first mode's damping. */
+  curve?: { fromHz: number; toHz: number; points: number } | null;
 }
 
 export interface RealizationChange {
@@ -264,6 +266,8 @@ export interface Realization {
   insensitivityRealised: Insensitivity;
   /** The frequency the realised shaper acts at when its times are the ideal ones scaled. */
   actsAsHz: number | null;
+  sensitivityIdeal: SensitivityCurve | null;
+  sensitivityRealised: SensitivityCurve | null;
 }
 
 // ---------------------------------------------------------------------------------------------

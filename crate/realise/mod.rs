@@ -56,7 +56,7 @@ use crate::firmware_limits::{
 use crate::measure::klipper::shapers::klipper_shaper;
 use crate::mode::Mode;
 use crate::shaper::{Impulse, Shaper, ShaperData};
-use crate::vibration::Insensitivity;
+use crate::vibration::{Insensitivity, SensitivityCurve};
 use definitions::{Named, Pulses};
 use serde::{Deserialize, Serialize};
 
@@ -134,6 +134,23 @@ pub struct RealiseOptions {
     /// Tolerable vibration for I(Vtol), fraction in (0, 1); default 0.05.
     #[serde(default = "default_vtol")]
     pub vtol: f64,
+    /// V(f) of both shapers over this range (at the first mode's damping), for a chart that
+    /// overlays them; default: no curves.
+    #[serde(default)]
+    pub curve: Option<CurveRange>,
+}
+
+/// The frequencies of [`Realisation::sensitivity_ideal`] and `…_realised` (JS:
+/// `{ fromHz, toHz, points }`), as for `sensitivity`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct CurveRange {
+    /// First frequency, Hz (≥ 0).
+    pub from_hz: f64,
+    /// Last frequency, Hz (> `fromHz`).
+    pub to_hz: f64,
+    /// Evenly spaced points, 2 … [`crate::vibration::MAX_CURVE_POINTS`].
+    pub points: usize,
 }
 
 fn default_vtol() -> f64 {
@@ -149,6 +166,7 @@ impl RealiseOptions {
             amplitude_steps: None,
             max_impulses: None,
             vtol: default_vtol(),
+            curve: None,
         }
     }
 }
@@ -219,6 +237,10 @@ pub struct Realisation {
     /// When the realised times are the ideal ones scaled by one factor s (within 2 % of the
     /// duration) and s ≠ 1: the frequency the realised shaper acts at, f₁/s.
     pub acts_as_hz: Option<f64>,
+    /// V(f) of the ideal shaper over `options.curve`, if asked.
+    pub sensitivity_ideal: Option<SensitivityCurve>,
+    /// V(f) of the realised shaper over `options.curve`, if asked.
+    pub sensitivity_realised: Option<SensitivityCurve>,
 }
 
 /// Realises the shaper `request` designs on the controller of `options`.
@@ -250,6 +272,11 @@ pub fn realise(request: &DesignRequest, options: &RealiseOptions) -> Result<Real
 /// name the option.
 pub fn check_options(options: &RealiseOptions) -> Result<()> {
     crate::vibration::tolerable_vibration(options.vtol)?;
+    if let Some(c) = options.curve {
+        // The same checks `sensitivity` makes, on a one-impulse shaper.
+        crate::vibration::sensitivity(&Shaper::identity(), &sensitivity_options(c, 0.0))
+            .map_err(|e| e.within("curve"))?;
+    }
     if let Some(p) = options.period_s {
         positive("periodS", p)?;
     }
@@ -309,6 +336,19 @@ pub fn realise_designed(
         )?,
     };
     report::build(request, modes, ideal, realised, runs, changes, options)
+}
+
+/// `sensitivity`'s options for a curve range at damping `zeta`.
+pub(crate) fn sensitivity_options(
+    c: CurveRange,
+    zeta: f64,
+) -> crate::vibration::SensitivityOptions {
+    crate::vibration::SensitivityOptions {
+        from_hz: c.from_hz,
+        to_hz: c.to_hz,
+        points: c.points,
+        damping: zeta,
+    }
 }
 
 /// The named family of `spec`, if firmware could run it by name.

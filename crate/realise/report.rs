@@ -6,7 +6,7 @@ use crate::design::DesignRequest;
 use crate::error::Result;
 use crate::mode::Mode;
 use crate::shaper::Shaper;
-use crate::vibration::{insensitivity, residual_vibration};
+use crate::vibration::{insensitivity, residual_vibration, sensitivity};
 
 /// Largest misfit, as a fraction of the ideal duration, between the realised times and the
 /// ideal ones scaled by one factor, for the realised shaper to be said to "act as" another
@@ -36,6 +36,15 @@ pub(super) fn build(
         })
         .collect();
     let acts_as_hz = time_scale(&ideal, &realised).map(|s| first.frequency_hz() / s);
+    let curve = |shaper: &Shaper| {
+        options
+            .curve
+            .map(|c| sensitivity(shaper, &super::sensitivity_options(c, first.damping())))
+            .transpose()
+            .map_err(|e| e.within("curve"))
+    };
+    let sensitivity_ideal = curve(&ideal)?;
+    let sensitivity_realised = curve(&realised)?;
     let summary = summary_for(
         &changes,
         request.shaper.name(),
@@ -55,6 +64,8 @@ pub(super) fn build(
         insensitivity_ideal,
         insensitivity_realised,
         acts_as_hz,
+        sensitivity_ideal,
+        sensitivity_realised,
     })
 }
 
