@@ -479,3 +479,16 @@ fn realisation_chart_overlays_designed_and_realised() {
         );
     }
 }
+
+/// Klipper's MZV (shaper_defs.py `get_mzv_shaper`, n = 3, t = 0.75) is the crate's `mzv`
+/// (crate::design::modified reproduces it): Klipper changes nothing, and V = 0 at the mode.
+#[test]
+fn klipper_mzv_is_the_crate_mzv() {
+    let r = on(Controller::Klipper, ShaperSpec::Mzv, 45.0, 0.1);
+    assert!(r.changes.is_empty(), "{:?}", r.changes);
+    for (a, b) in r.realised.impulses.iter().zip(&r.ideal.impulses) {
+        close(a.amplitude, b.amplitude, 1e-12, "amplitude");
+        close(a.time, b.time, 1e-15, "time");
+    }
+    assert!(r.modes[0].vibration_realised < 1e-9);
+}
