@@ -21,6 +21,9 @@
 //! - [`design`](mod@design): the spec, the table of families, and one file per family of the literature.
 //! - [`smoothing`]: Klipper-compatible smoothing and suggested maximum acceleration.
 //! - [`export`]: CSV, JSON, C arrays and RepRapFirmware `M593` lines.
+//! - [`realise`](mod@realise): what a controller runs instead of the designed shaper (Klipper,
+//!   Kalico, RRF, Marlin classic and FT_MOTION, Prusa, a generic period/steps/cap), and what it
+//!   costs.
 //! - [`firmware_limits`]: what each firmware's shaper accepts (impulses, duration, amplitudes,
 //!   frequency), cited from its source; read by the optimiser and the config writer.
 //! - [`command`]: reference commands (step, ramp, trapezoid, S-curve, sampled) and shaping
@@ -60,7 +63,7 @@
 //! scenario   scenario
 //! measured   measure
 //! charts     chart
-//! export     export
+//! export     export realise
 //! js         js
 //! ```
 //!
@@ -79,6 +82,7 @@ pub mod mode;
 pub mod piecewise;
 pub mod plant;
 pub mod profile;
+pub mod realise;
 pub mod robustness;
 pub mod scenario;
 pub mod shaper;

@@ -396,6 +396,29 @@ pub fn quantize(
     to_js(&report)
 }
 
+/// `realizeShaper(spec, { firmware, periodS?, amplitudeSteps?, maxImpulses?, vtol? })` →
+/// `{ firmware, ideal, realised, runs, changes: [{ kind, text }], summary, modes:
+/// [{ frequencyHz, damping, vibrationIdeal, vibrationRealised }], vtol, insensitivityIdeal,
+/// insensitivityRealised, actsAsHz }`: the shaper `spec` designs as the controller runs it
+/// (crate::realise). Errors in the options (and a firmware that cannot run the design) name
+/// `options.<field>`; errors in the spec name its fields from the root.
+#[cfg(feature = "js-api")]
+#[wasm_bindgen(js_name = realizeShaper, unchecked_return_type = "Realization")]
+pub fn realize_shaper(
+    #[wasm_bindgen(unchecked_param_type = "DesignSpec")] spec: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "RealizeOptions")] options: JsValue,
+) -> Result<JsValue, JsValue> {
+    let request: DesignRequest = from_js_root(spec, "spec").map_err(js_error)?;
+    let options: crate::realise::RealiseOptions = from_js(options, "options").map_err(js_error)?;
+    let in_options = |e: Error| js_error(e.within("options"));
+    crate::realise::check_options(&options).map_err(in_options)?;
+    let modes = Mode::list(&request.modes).map_err(js_error)?;
+    let ideal = design::design_for(&request.shaper, &modes).map_err(js_error)?;
+    let result =
+        crate::realise::realise_designed(&request, &modes, ideal, &options).map_err(in_options)?;
+    to_js(&result)
+}
+
 /// `simulate(spec)`: `spec = { plant, command, shaper? | impulses?, duration?, samplePeriod? |
 /// sampleRateHz? }` → `{ time, unshaped: { basePosition, baseVelocity, baseAcceleration,
 /// endpoint, endpointVelocity, endpointAcceleration, deflection, swingAngle?, metrics },

@@ -216,6 +216,60 @@ export interface QuantizeReport extends Shaper {
   insensitivityAfter: Insensitivity;
 }
 
+/** The controller of `realizeShaper` (docs/js-api.md, *What your controller runs*). */
+export type Controller =
+  | "ideal"
+  | "klipper"
+  | "kalico"
+  | "rrf"
+  | "marlin"
+  | "marlinFtMotion"
+  | "prusa"
+  | "generic";
+
+export interface RealizeOptions {
+  firmware: Controller;
+  /** s: Marlin's timer tick, FT_MOTION's period, the generic controller's period. */
+  periodS?: number | null;
+  /** Generic controller: amplitudes to multiples of 1/N, 1 … 2²⁴. */
+  amplitudeSteps?: number | null;
+  /** Generic controller: most impulses, 1 … 10000. */
+  maxImpulses?: number | null;
+  vtol?: number;
+  /** V(f) of both shapers over this range, at the first mode's damping. */
+  curve?: { fromHz: number; toHz: number; points: number } | null;
+}
+
+export interface RealizationChange {
+  kind: "family" | "times" | "amplitudes" | "impulses" | "modes";
+  text: string;
+}
+
+export interface RealizationMode {
+  frequencyHz: number;
+  damping: number;
+  vibrationIdeal: number;
+  vibrationRealised: number;
+}
+
+export interface Realization {
+  firmware: Controller;
+  ideal: Shaper;
+  realised: Shaper;
+  /** The family the controller runs, in its own form, or "custom". */
+  runs: string;
+  changes: RealizationChange[];
+  summary: string;
+  modes: RealizationMode[];
+  vtol: number;
+  insensitivityIdeal: Insensitivity;
+  insensitivityRealised: Insensitivity;
+  /** The frequency the realised shaper acts at when its times are the ideal ones scaled. */
+  actsAsHz: number | null;
+  sensitivityIdeal: SensitivityCurve | null;
+  sensitivityRealised: SensitivityCurve | null;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Commands, plants, simulation
 

@@ -136,6 +136,7 @@ function exportsTable(env) {
     { name: 'rampDelay', names: ['shaper', 'mode'], args: () => [shaper(), mode()] },
     { name: 'sampledReport', names: [null], args: () => [{ family: 'sampled', periodS: 0.012, impulses: 36, delaySamples: 17, modes: [{ frequencyHz: 4.7746, damping: 0.02 }] }] },
     { name: 'quantize', names: ['shaper', 'mode', 'options'], args: () => [shaper(), mode(), { amplitudeSteps: 255, tickS: 0.001 }] },
+    { name: 'realizeShaper', names: [null, 'options'], args: () => [{ family: 'zv', modes: [{ frequencyHz: 60, damping: 0 }] }, { firmware: 'generic', periodS: 0.001, amplitudeSteps: 255, maxImpulses: 5, curve: { fromHz: 0, toHz: 150, points: 64 } }] },
     { name: 'simulate', names: [null], args: () => [{ plant: { kind: 'modal', modes: [{ frequencyHz: 4, damping: 0.05 }] }, command: { kind: 'trapezoid', distance: 1, maxVelocity: 1, maxAcceleration: 4 }, shaper: { family: 'zvd' }, sampleRateHz: 100 }] },
     { name: 'spectrum', names: [null], args: () => [{ command: { kind: 'step' }, shaper: { family: 'zvd', modes: [{ frequencyHz: 1 }] }, toHz: 5, points: 64 }] },
     { name: 'renderPlayground', names: [null, 'canvases'], args: () => [{ modes: [{ frequencyHz: 40, damping: 0.05 }], shapers: [{ family: 'zv' }], view: { vtol: 0.05, points: 50, samples: 200, mapFrequencyPoints: 8, mapDampingPoints: 4, dampingPoints: 8, spectrumPoints: 32 } }, {}] },

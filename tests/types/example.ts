@@ -16,6 +16,7 @@ import init, {
   rampDelay,
   sampledReport,
   quantize,
+  realizeShaper,
   simulate,
   spectrum,
   renderPlayground,
@@ -101,6 +102,9 @@ export async function main(canvas: HTMLCanvasElement): Promise<void> {
   const report = sampledReport({ family: "sampled", periodS: 0.012, impulses: 36, modes: [mode] });
   const rounded = quantize(zvd, mode, { amplitudeSteps: 255, method: "largestRemainder" });
   console.log(csv, accel, tau, report.cost.total, rounded.insensitivityAfter.width, first);
+  const onFtMotion = realizeShaper({ family: "zv", modes: [mode] }, { firmware: "marlinFtMotion" });
+  const hz: number | null = onFtMotion.actsAsHz;
+  console.log(onFtMotion.summary, onFtMotion.changes[0]?.kind, onFtMotion.modes[0].vibrationRealised, hz);
 
   // Simulation: plants discriminated by `kind`, commands by `kind` (and profiles by `shape`).
   const sim: SimulationResult = simulate({

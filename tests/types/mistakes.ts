@@ -10,6 +10,7 @@ import {
   robustnessTable,
   exportShaper,
   quantize,
+  realizeShaper,
   simulate,
   spectrum,
   renderPlayground,
@@ -70,6 +71,9 @@ robustnessTable(mode, 0.05, [{ family: "zz" }]);
 // A quantize method that does not exist.
 // @ts-expect-error TS2322
 quantize(shaper, mode, { amplitudeSteps: 255, method: "round" });
+// A firmware that does not exist.
+// @ts-expect-error TS2322
+realizeShaper({ family: "zv", modes: [mode] }, { firmware: "smoothieware" });
 // A command kind that does not exist.
 // @ts-expect-error TS2322
 simulate({ plant: { kind: "modal", modes: [mode] }, command: { kind: "jump" } });

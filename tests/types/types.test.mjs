@@ -179,6 +179,10 @@ function calls(exports) {
   add('number', api.rampDelay(zvd, mode));
   add('SampledReport', api.sampledReport({ family: 'sampled', periodS: 0.05, impulses: 20, delaySamples: 5, modes: [mode] }));
   add('QuantizeReport', api.quantize(zvd, mode, { amplitudeSteps: 255, tickS: 0.001 }));
+  for (const firmware of ['ideal', 'klipper', 'kalico', 'rrf', 'marlin', 'marlinFtMotion', 'prusa', 'generic']) {
+    add('Realization', api.realizeShaper({ family: 'mzv', modes: [{ frequencyHz: 40, damping: 0.1 }] }, { firmware, periodS: firmware === 'generic' ? 0.001 : null }));
+  }
+  add('Realization', api.realizeShaper({ family: 'zvd', modes: [{ frequencyHz: 40, damping: 0.05 }, { frequencyHz: 90, damping: 0.02 }] }, { firmware: 'kalico', vtol: 0.1, curve: { fromHz: 0, toHz: 200, points: 5 } }));
   const modal = { kind: 'modal', modes: [{ frequencyHz: 1.2, damping: 0.012 }, { frequencyHz: 3.4, damping: 0.013, participation: 0.3 }] };
   add('SimulationResult', api.simulate({ plant: modal, command: { kind: 'trapezoid', distance: 1, maxVelocity: 1, maxAcceleration: 4 }, shaper: { family: 'zvd' }, sampleRateHz: 100 }));
   add('SimulationResult', api.simulate({ plant: { kind: 'pendulum', length: 1 }, command: { kind: 'sCurve', distance: 1, maxVelocity: 1, maxAcceleration: 2, maxJerk: 10 }, samplePeriod: 0.05 }));
