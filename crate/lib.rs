@@ -56,7 +56,7 @@
 //! design     design
 //! motion     piecewise profile command
 //! plants     plant
-//! results    simulate metrics spectrum robustness
+//! results    simulate metrics spectrum robustness corner
 //! scenario   scenario
 //! measured   measure
 //! charts     chart
@@ -69,6 +69,7 @@
 
 pub mod chart;
 pub mod command;
+pub mod corner;
 pub mod design;
 pub mod error;
 pub mod export;
