@@ -2,6 +2,8 @@
 //! Vtol = 5 %, I = 0.7), sampled at six frequencies (the problem benches/si_slsqp.py solves
 //! with scipy's SLSQP from random starts) and over the whole band.
 //!
+//! Also issue 24's three-mode case (1.2 / 3.4 / 7.9 Hz, ζ 0.02, I 0.3 and 0.7).
+//!
 //! `cargo bench --bench si` (native only). Compare with `python3 benches/si_slsqp.py`.
 
 #![cfg_attr(target_arch = "wasm32", allow(unused))]
@@ -26,6 +28,24 @@ fn request(sampled: bool) -> DesignRequest {
     }])
 }
 
+/// Issue 24's multi-mode case: `si` over 1.2 / 3.4 / 7.9 Hz (ζ = 0.02 each, Vtol 5 %) at
+/// insensitivity `i`.
+fn three_modes(i: f64) -> DesignRequest {
+    SiSpec {
+        insensitivity: Some(i),
+        vtol: 0.05,
+        ..Default::default()
+    }
+    .request(
+        [1.2, 3.4, 7.9]
+            .map(|f| ModeSpec {
+                frequency_hz: f,
+                damping: 0.02,
+            })
+            .to_vec(),
+    )
+}
+
 #[cfg(not(target_arch = "wasm32"))]
 fn bench(c: &mut Criterion) {
     for (name, sampled) in [("si_sampled_six", true), ("si_whole_band", false)] {
@@ -46,8 +66,28 @@ fn bench(c: &mut Criterion) {
     }
 }
 
+/// The three-mode designs take 0.1–1 s each: ten samples.
 #[cfg(not(target_arch = "wasm32"))]
-criterion_group!(benches, bench);
+fn bench_three_modes(c: &mut Criterion) {
+    let mut group = c.benchmark_group("si_three_modes");
+    group.sample_size(10);
+    for i in [0.3, 0.7] {
+        let req = three_modes(i);
+        let s = design(&req).expect("design");
+        eprintln!(
+            "si three modes I {i}: duration {:.6} s, {} impulses",
+            s.duration(),
+            s.len()
+        );
+        group.bench_function(format!("i{i}"), |b| {
+            b.iter(|| design(black_box(&req)).expect("design"))
+        });
+    }
+    group.finish();
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+criterion_group!(benches, bench, bench_three_modes);
 #[cfg(not(target_arch = "wasm32"))]
 criterion_main!(benches);
 
@@ -55,4 +95,5 @@ criterion_main!(benches);
 #[cfg(target_arch = "wasm32")]
 fn main() {
     let _ = design(&request(true));
+    let _ = design(&three_modes(0.3));
 }

@@ -59,7 +59,7 @@
 //! design     design
 //! motion     piecewise profile command
 //! plants     plant
-//! results    simulate metrics spectrum robustness
+//! results    simulate metrics spectrum robustness corner
 //! scenario   scenario
 //! measured   measure
 //! charts     chart
@@ -72,6 +72,7 @@
 
 pub mod chart;
 pub mod command;
+pub mod corner;
 pub mod design;
 pub mod error;
 pub mod export;

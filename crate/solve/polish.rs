@@ -21,7 +21,7 @@ use super::{
     clusters, ratio, Cluster, GridSolution, NormalizedLimit, NormalizedProblem, CHECK_TOLERANCE,
 };
 use crate::shaper::Impulse;
-use crate::vibration::{impulse_phasor, vibration_moment};
+use crate::vibration::{impulse_phasor, vibration_moments};
 use nalgebra::{DMatrix, DVector};
 
 /// Most clusters split in two when looking for a structure that polishes.
@@ -100,6 +100,14 @@ enum Con {
     Stationary { point: usize, coord: usize },
 }
 
+/// The moment sums of [`Setup::sums`]: per zero, M₀ … M_d; per active point, its (ω, ζ) and
+/// M₀ (and M₁).
+#[derive(Debug, Clone)]
+struct Sums {
+    zeros: Vec<Vec<[f64; 2]>>,
+    points: Vec<(f64, f64, Vec<[f64; 2]>)>,
+}
+
 /// The unknowns and equations of one Newton solve.
 #[derive(Debug, Clone)]
 struct Setup<'a> {
@@ -144,6 +152,34 @@ impl Setup<'_> {
     /// c(y).
     fn residuals(&self, y: &[f64]) -> Vec<f64> {
         let imps = self.impulses(y);
+        let sums = self.sums(&imps, y);
+        self.rows(&sums, &imps)
+    }
+
+    /// The moments c(y) is made of, each computed once: every order at each zero, and M₀ (with
+    /// M₁ where a stationarity row needs it) at each active point — not once per row.
+    fn sums(&self, imps: &[Impulse], y: &[f64]) -> Sums {
+        let zeros = self
+            .norm
+            .zeros
+            .iter()
+            .map(|z| vibration_moments(imps, z.omega, z.zeta, z.derivatives))
+            .collect();
+        let points = self
+            .points
+            .iter()
+            .map(|pt| {
+                let (w, z) = (self.coord(pt.omega, y), self.coord(pt.zeta, y));
+                let stationary =
+                    matches!(pt.omega, Coord::Free(_)) || matches!(pt.zeta, Coord::Free(_));
+                (w, z, vibration_moments(imps, w, z, u32::from(stationary)))
+            })
+            .collect();
+        Sums { zeros, points }
+    }
+
+    /// c from its moments (and the impulses, for Σ A, the bounds and t_n).
+    fn rows(&self, sums: &Sums, imps: &[Impulse]) -> Vec<f64> {
         let t_n = imps.last().map_or(0.0, |i| i.time);
         self.cons
             .iter()
@@ -154,20 +190,17 @@ impl Setup<'_> {
                     order,
                     part,
                     scale,
-                } => {
-                    let z = &self.norm.zeros[zero];
-                    vibration_moment(&imps, z.omega, z.zeta, order)[part] / scale
-                }
+                } => sums.zeros[zero][order as usize][part] / scale,
                 Con::Bound { index, value, .. } => imps[index].amplitude - value,
                 Con::Limit(p) => {
-                    let pt = &self.points[p];
-                    let (w, z) = (self.coord(pt.omega, y), self.coord(pt.zeta, y));
-                    ratio(&imps, w, z, self.vtol_of(pt, w).0) - 1.0
+                    let (w, _, m) = &sums.points[p];
+                    let [c0, s0] = m[0];
+                    c0.hypot(s0) / self.vtol_of(&self.points[p], *w).0 - 1.0
                 }
                 Con::Stationary { point, coord } => {
-                    let pt = &self.points[point];
-                    let (w, z) = (self.coord(pt.omega, y), self.coord(pt.zeta, y));
-                    log_slope(&imps, t_n, w, z, coord, self.vtol_of(pt, w))
+                    let (w, z, m) = &sums.points[point];
+                    let vtol = self.vtol_of(&self.points[point], *w);
+                    log_slope(m[0], m[1], t_n, *w, *z, coord, vtol)
                 }
             })
             .collect()
@@ -230,15 +263,14 @@ impl Setup<'_> {
 /// of eq. 11: with M = M₀ as a complex number, dM/dω = −ζ t_n M₀ + (ζ + i√(1−ζ²)) M₁ and
 /// dM/dζ = −ω t_n M₀ + ω(1 − iζ/√(1−ζ²)) M₁ (differentiating e^{−ζω(t_n−t)} e^{iω√(1−ζ²) t}).
 fn log_slope(
-    imps: &[Impulse],
+    [c0, s0]: [f64; 2],
+    [c1, s1]: [f64; 2],
     t_n: f64,
     omega: f64,
     zeta: f64,
     coord: usize,
     (vtol, vtol_slope): (f64, f64),
 ) -> f64 {
-    let [c0, s0] = vibration_moment(imps, omega, zeta, 0);
-    let [c1, s1] = vibration_moment(imps, omega, zeta, 1);
     let root = (1.0 - zeta * zeta).sqrt();
     let (dc, ds) = if coord == 0 {
         (
