@@ -145,6 +145,57 @@ fn joint_fit(
     true
 }
 
+/// The peaks of a sweep's start (identify/raw.rs, `start_peaks`), each fitted alone on its
+/// own band by the joint model with one mode, without the window's kernel: the periodogram of
+/// a mode the sweep's start rang, which has died out within the record, is the spectrum of
+/// the whole response — no leakage to model (the kernel would read the peak as narrower
+/// than it is). A mode joins the slots when the fit stays on its peak, stands ≥ 3 dB over
+/// the model without it (as a mode found in the residuals must) and is resolved: its
+/// half-power width at least 1.5 bins (a steady line — a slow sweep's harmonic — is one bin
+/// wide, 0.89 for the rectangular window, and cannot be told from a mode narrower than that).
+fn local_fits(psd: &Psd, locals: &[raw::Local], kind: SignalKind, slots: &mut Vec<Slot>) {
+    let df = psd.resolution_hz;
+    for l in locals {
+        let input = ModelInput {
+            frequency_hz: &psd.frequency_hz,
+            psd: &psd.psd,
+            resolution_hz: df,
+            even: true,
+            window: None,
+            klipper_normalized: false,
+            kind,
+            enbw_bins: psd.enbw_bins,
+            band: l.band,
+        };
+        let seed = Seed {
+            frequency_hz: l.half.estimate.frequency_hz,
+            damping: l.half.estimate.damping,
+            peak_psd: l.half.peak_psd,
+            peak: Some(0),
+        };
+        let Some(fitted) = fit_modes(&input, &[seed], 1) else {
+            continue;
+        };
+        let Some(m) = fitted.into_iter().find(|m| m.peak == Some(0)) else {
+            continue;
+        };
+        let width = 2.0 * m.estimate.damping * m.estimate.frequency_hz;
+        if width < 1.5 * df || m.standing_db < 3.0 {
+            continue;
+        }
+        let mut slot = Slot {
+            peak_hz: l.half.peak_hz,
+            peak_psd: l.half.peak_psd,
+            prominence_db: l.peak.prominence_db,
+            estimates: vec![l.half.estimate],
+        };
+        slot.push_fit(m.estimate);
+        if slot.estimates.len() == 2 {
+            slots.push(slot);
+        }
+    }
+}
+
 /// Most modes [`identify`] returns.
 pub const MAX_MODES: usize = 8;
 
@@ -342,7 +393,12 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
     let Some(stage) = stage else {
         return Ok(result);
     };
-    let raw::Stage { psd, found, band } = stage;
+    let raw::Stage {
+        psd,
+        found,
+        band,
+        local,
+    } = stage;
     let halves: Vec<HalfPower> = found.iter().map(|(_, h)| *h).collect();
     let mut slots: Vec<Slot> = found
         .iter()
@@ -382,6 +438,13 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
                 slot.push_fit(f);
             }
         }
+    }
+    local_fits(&psd, &local, options.signal, &mut slots);
+    if slots.len() > options.max_modes {
+        crate::sort::sort_by(&mut slots, |a, b| {
+            b.prominence_db.total_cmp(&a.prominence_db)
+        });
+        slots.truncate(options.max_modes);
     }
     if options.free_decay && !slots.is_empty() {
         result.free_decay = raw::free_decay_stage(signal, fs, &mut slots);
