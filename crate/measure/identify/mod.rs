@@ -11,7 +11,10 @@
 //!    is |H|²·|A|² with |A(f)|² ∝ f² smooth, while a Welch average of shorter segments is lumpy
 //!    (each segment sees a few hertz of the sweep) and outside the band there is only noise.
 //!    Steps 1–3 then run on that periodogram (peaks smoothed over about √r/4, the
-//!    rectangular window's kernel in the fit); `spectrum` stays the detection PSD. Otherwise:
+//!    rectangular window's kernel in the fit); `spectrum` stays the detection PSD. Peaks
+//!    below that band (the sweep's start, where its spectrum is not smooth) narrower than
+//!    √r/4 are fitted each alone on ±3 half-power widths, without the kernel (`local_fits`:
+//!    slow modes rung by the start). Otherwise:
 //! 1. **Peaks.** A Welch PSD (Hann, half overlap, segments of 2^⌊log₂(n/4)⌋ samples by default)
 //!    is smoothed in dB over 7 bins; its local maxima with a topographic prominence of at least
 //!    `minProminenceDb` inside the band are the candidate modes, the most prominent first.
