@@ -171,10 +171,12 @@ pub(super) fn welch_stage(
     if hi0 <= lo0 + 4 {
         return Ok(None);
     }
-    let peaks = detect(
+    // Smoothed and read from the second bin (below the band too): a peak a few bins above
+    // the band's start keeps its own flank instead of a smoothing cut at the start.
+    let peaks = detect_within(
         &psd0,
-        lo0,
-        hi0,
+        [lo0, hi0],
+        [1, hi0],
         options.min_prominence_db,
         options.max_modes,
         3,
@@ -186,7 +188,13 @@ pub(super) fn welch_stage(
     let mut psd = psd0;
     let (mut seg, mut shrunk) = (n0, false);
     let widths = loop {
-        let widths = half_powers(&psd, &peaks, band, 4.0 * df0, options);
+        let widths = half_powers(
+            &psd,
+            &peaks,
+            [psd.resolution_hz, band[1]],
+            4.0 * df0,
+            options,
+        );
         let narrowest = widths
             .iter()
             .flatten()
