@@ -33,8 +33,9 @@
 //!    (identify/spectrum_fit.rs: white-noise excitation, kernel only near narrow peaks) is the
 //!    fallback when the joint fit fails.
 //! 4. **Free decay** (time domain). If the recording rings down after a hit (a block of two
-//!    periods at least 20 dB above the median block, less than half of it two blocks earlier;
-//!    the decay ends where the blocks fall below twice the median), the ring-down is
+//!    periods at least 20 dB above the quiet level — the lower quartile of the blocks — less
+//!    than half of it two blocks earlier; the decay ends where the blocks fall below twice the
+//!    quiet level), the ring-down is
 //!    fitted by least squares with y(τ) = Σᵢ e^{−σᵢτ}(aᵢ cos ω_dᵢτ + bᵢ sin ω_dᵢτ) + c₀ + c₁τ
 //!    (variable projection: the linear aᵢ, bᵢ, c₀, c₁ are solved for every σ, ω_d; the drift
 //!    terms absorb a slow offset). This is the least-squares form of the logarithmic decrement
@@ -333,7 +334,7 @@ pub struct FreeDecay {
     pub start_s: f64,
     /// End of it, s from the first sample.
     pub end_s: f64,
-    /// RMS of the strongest block over the median block, dB.
+    /// RMS of the strongest block over the quiet level (the lower quartile of the blocks), dB.
     pub level_db: f64,
 }
 
