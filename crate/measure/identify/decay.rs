@@ -4,7 +4,10 @@ use super::{Estimate, Method};
 use crate::measure::fit::{levenberg_marquardt, FitResult};
 use std::f64::consts::PI;
 
-/// Finds a ring-down: returns (start, end) sample indices and its level in dB.
+/// Finds a ring-down: returns (start, end) sample indices and its level in dB: the strongest
+/// block of two periods of the lowest mode at least 20 dB over the quiet level (the lower
+/// quartile of the blocks), the block two before it at most half of it (a hit, not a slow
+/// build-up); the decay ends where the blocks fall below twice the quiet level.
 pub(super) fn find_decay(signal: &[f64], fs: f64, lowest_hz: f64) -> Option<(usize, usize, f64)> {
     let n = signal.len();
     let block = ((2.0 * fs / lowest_hz).round() as usize).max(8);
@@ -21,7 +24,9 @@ pub(super) fn find_decay(signal: &[f64], fs: f64, lowest_hz: f64) -> Option<(usi
         .collect();
     let mut sorted = rms.clone();
     sorted.sort_by(f64::total_cmp);
-    let median = sorted[blocks / 2].max(1e-300);
+    // The quiet level: the lower quartile of the blocks, not their median — a short record
+    // can be mostly ring-down (its median block then lies inside the decay).
+    let median = sorted[blocks / 4].max(1e-300);
     let (b_max, &top) = rms.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1))?;
     let level_db = 20.0 * (top / median).log10();
     if level_db < 20.0 {

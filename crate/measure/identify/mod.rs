@@ -11,7 +11,10 @@
 //!    is |H|²·|A|² with |A(f)|² ∝ f² smooth, while a Welch average of shorter segments is lumpy
 //!    (each segment sees a few hertz of the sweep) and outside the band there is only noise.
 //!    Steps 1–3 then run on that periodogram (peaks smoothed over about √r/4, the
-//!    rectangular window's kernel in the fit); `spectrum` stays the detection PSD. Otherwise:
+//!    rectangular window's kernel in the fit); `spectrum` stays the detection PSD. Peaks
+//!    below that band (the sweep's start, where its spectrum is not smooth) narrower than
+//!    √r/4 are fitted each alone on ±3 half-power widths, without the kernel (`local_fits`:
+//!    slow modes rung by the start). Otherwise:
 //! 1. **Peaks.** A Welch PSD (Hann, half overlap, segments of 2^⌊log₂(n/4)⌋ samples by default)
 //!    is smoothed in dB over 7 bins; its local maxima with a topographic prominence of at least
 //!    `minProminenceDb` inside the band are the candidate modes, the most prominent first.
@@ -30,8 +33,9 @@
 //!    (identify/spectrum_fit.rs: white-noise excitation, kernel only near narrow peaks) is the
 //!    fallback when the joint fit fails.
 //! 4. **Free decay** (time domain). If the recording rings down after a hit (a block of two
-//!    periods at least 20 dB above the median block, less than half of it two blocks earlier;
-//!    the decay ends where the blocks fall below twice the median), the ring-down is
+//!    periods at least 20 dB above the quiet level — the lower quartile of the blocks — less
+//!    than half of it two blocks earlier; the decay ends where the blocks fall below twice the
+//!    quiet level), the ring-down is
 //!    fitted by least squares with y(τ) = Σᵢ e^{−σᵢτ}(aᵢ cos ω_dᵢτ + bᵢ sin ω_dᵢτ) + c₀ + c₁τ
 //!    (variable projection: the linear aᵢ, bᵢ, c₀, c₁ are solved for every σ, ω_d; the drift
 //!    terms absorb a slow offset). This is the least-squares form of the logarithmic decrement
@@ -143,6 +147,57 @@ fn joint_fit(
         }
     }
     true
+}
+
+/// The peaks of a sweep's start (identify/raw.rs, `start_peaks`), each fitted alone on its
+/// own band by the joint model with one mode, without the window's kernel: the periodogram of
+/// a mode the sweep's start rang, which has died out within the record, is the spectrum of
+/// the whole response — no leakage to model (the kernel would read the peak as narrower
+/// than it is). A mode joins the slots when the fit stays on its peak, stands ≥ 3 dB over
+/// the model without it (as a mode found in the residuals must) and is resolved: its
+/// half-power width at least 1.5 bins (a steady line — a slow sweep's harmonic — is one bin
+/// wide, 0.89 for the rectangular window, and cannot be told from a mode narrower than that).
+fn local_fits(psd: &Psd, locals: &[raw::Local], kind: SignalKind, slots: &mut Vec<Slot>) {
+    let df = psd.resolution_hz;
+    for l in locals {
+        let input = ModelInput {
+            frequency_hz: &psd.frequency_hz,
+            psd: &psd.psd,
+            resolution_hz: df,
+            even: true,
+            window: None,
+            klipper_normalized: false,
+            kind,
+            enbw_bins: psd.enbw_bins,
+            band: l.band,
+        };
+        let seed = Seed {
+            frequency_hz: l.half.estimate.frequency_hz,
+            damping: l.half.estimate.damping,
+            peak_psd: l.half.peak_psd,
+            peak: Some(0),
+        };
+        let Some(fitted) = fit_modes(&input, &[seed], 1) else {
+            continue;
+        };
+        let Some(m) = fitted.into_iter().find(|m| m.peak == Some(0)) else {
+            continue;
+        };
+        let width = 2.0 * m.estimate.damping * m.estimate.frequency_hz;
+        if width < 1.5 * df || m.standing_db < 3.0 {
+            continue;
+        }
+        let mut slot = Slot {
+            peak_hz: l.half.peak_hz,
+            peak_psd: l.half.peak_psd,
+            prominence_db: l.peak.prominence_db,
+            estimates: vec![l.half.estimate],
+        };
+        slot.push_fit(m.estimate);
+        if slot.estimates.len() == 2 {
+            slots.push(slot);
+        }
+    }
 }
 
 /// Most modes [`identify`] returns.
@@ -279,7 +334,7 @@ pub struct FreeDecay {
     pub start_s: f64,
     /// End of it, s from the first sample.
     pub end_s: f64,
-    /// RMS of the strongest block over the median block, dB.
+    /// RMS of the strongest block over the quiet level (the lower quartile of the blocks), dB.
     pub level_db: f64,
 }
 
@@ -342,7 +397,12 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
     let Some(stage) = stage else {
         return Ok(result);
     };
-    let raw::Stage { psd, found, band } = stage;
+    let raw::Stage {
+        psd,
+        found,
+        band,
+        local,
+    } = stage;
     let halves: Vec<HalfPower> = found.iter().map(|(_, h)| *h).collect();
     let mut slots: Vec<Slot> = found
         .iter()
@@ -382,6 +442,13 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
                 slot.push_fit(f);
             }
         }
+    }
+    local_fits(&psd, &local, options.signal, &mut slots);
+    if slots.len() > options.max_modes {
+        crate::sort::sort_by(&mut slots, |a, b| {
+            b.prominence_db.total_cmp(&a.prominence_db)
+        });
+        slots.truncate(options.max_modes);
     }
     if options.free_decay && !slots.is_empty() {
         result.free_decay = raw::free_decay_stage(signal, fs, &mut slots);

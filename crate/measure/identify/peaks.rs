@@ -9,9 +9,9 @@ pub(super) struct Peak {
     pub(super) prominence_db: f64,
 }
 
-/// Local maxima of the 7-bin-smoothed dB spectrum in bins `lo..=hi`, with their topographic
-/// prominence (height over the higher of the lowest points between it and a higher point on
-/// each side, or the band's end).
+/// Local maxima of the dB spectrum smoothed over 2h + 1 bins in bins `lo..=hi`, with their
+/// topographic prominence (height over the higher of the lowest points between it and a higher
+/// point on each side, or the band's end).
 pub(super) fn detect(
     psd: &Psd,
     lo: usize,
@@ -20,6 +20,21 @@ pub(super) fn detect(
     max_modes: usize,
     h: usize,
 ) -> Vec<Peak> {
+    detect_within(psd, [lo, hi], [lo, hi], min_db, max_modes, h)
+}
+
+/// [`detect`] with the peaks in bins `band[0]..=band[1]` but the smoothing and the prominence
+/// read over the wider `context` (the spectrum around the band: a peak near the band's end
+/// then keeps its flank beyond it, instead of the end standing for its base).
+pub(super) fn detect_within(
+    psd: &Psd,
+    band: [usize; 2],
+    context: [usize; 2],
+    min_db: f64,
+    max_modes: usize,
+    h: usize,
+) -> Vec<Peak> {
+    let [lo, hi] = context;
     let db: Vec<f64> = psd
         .psd
         .iter()
@@ -35,6 +50,9 @@ pub(super) fn detect(
     let n = sm.len();
     let mut peaks = Vec::new();
     for i in 1..n.saturating_sub(1) {
+        if lo + i < band[0] || lo + i > band[1] {
+            continue;
+        }
         if !(sm[i] > sm[i - 1] && sm[i] >= sm[i + 1]) {
             continue;
         }
@@ -60,8 +78,8 @@ pub(super) fn detect(
         if prominence >= min_db {
             // The raw maximum near the smoothed one.
             let k0 = lo + i;
-            let a = k0.saturating_sub(h).max(lo);
-            let b = (k0 + h).min(hi);
+            let a = k0.saturating_sub(h).max(band[0]);
+            let b = (k0 + h).min(band[1]);
             let k = (a..=b)
                 .max_by(|&x, &y| psd.psd[x].total_cmp(&psd.psd[y]))
                 .unwrap_or(k0);

@@ -5,17 +5,26 @@
 
 use super::decay::{decay_fit, find_decay};
 use super::half_power::{half_power, smoothed, HalfPower};
-use super::peaks::{detect, Peak};
+use super::peaks::{detect, detect_within, Peak};
 use super::sweep::Sweep;
-use super::{FreeDecay, IdentifyOptions, Slot};
+use super::{FreeDecay, IdentifyOptions, Slot, MAX_MODES};
 use crate::error::{count, positive, Error, Result};
 use crate::measure::psd::{welch, Detrend, Psd, Scaling, WelchOptions, WindowKind};
 
 /// What the fits start from: the spectrum, its peaks with their half-power seeds (one per
-/// maximum), and the band fitted.
+/// maximum), the band fitted, and peaks fitted each on its own (a sweep's start).
 pub(super) struct Stage {
     pub psd: Psd,
     pub found: Vec<(Peak, HalfPower)>,
+    pub band: [f64; 2],
+    pub local: Vec<Local>,
+}
+
+/// A peak below the part of a sweep whose spectrum is smooth, to be fitted alone on `band`
+/// (see [`sweep_stage`]).
+pub(super) struct Local {
+    pub peak: Peak,
+    pub half: HalfPower,
     pub band: [f64; 2],
 }
 
@@ -162,10 +171,12 @@ pub(super) fn welch_stage(
     if hi0 <= lo0 + 4 {
         return Ok(None);
     }
-    let peaks = detect(
+    // Smoothed and read from the second bin (below the band too): a peak a few bins above
+    // the band's start keeps its own flank instead of a smoothing cut at the start.
+    let peaks = detect_within(
         &psd0,
-        lo0,
-        hi0,
+        [lo0, hi0],
+        [1, hi0],
         options.min_prominence_db,
         options.max_modes,
         3,
@@ -177,7 +188,13 @@ pub(super) fn welch_stage(
     let mut psd = psd0;
     let (mut seg, mut shrunk) = (n0, false);
     let widths = loop {
-        let widths = half_powers(&psd, &peaks, band, 4.0 * df0, options);
+        let widths = half_powers(
+            &psd,
+            &peaks,
+            [psd.resolution_hz, band[1]],
+            4.0 * df0,
+            options,
+        );
         let narrowest = widths
             .iter()
             .flatten()
@@ -199,7 +216,12 @@ pub(super) fn welch_stage(
         psd = welch(signal, &hann_welch(fs, seg))?;
     };
     let found = unique(&peaks, &widths);
-    Ok(Some(Stage { psd, found, band }))
+    Ok(Some(Stage {
+        psd,
+        found,
+        band,
+        local: Vec::new(),
+    }))
 }
 
 /// The sweep path: the whole record's periodogram (rectangular window, linear trend removed:
@@ -249,19 +271,75 @@ pub(super) fn sweep_stage(
         options.max_modes,
         h,
     );
-    if peaks.is_empty() {
-        return Ok(None);
-    }
     let widths = half_powers(&psd, &peaks, fit_band, (2 * h + 1) as f64 * df, options);
     let found = unique(&peaks, &widths);
-    if found.is_empty() {
+    let local = start_peaks(&psd, sweep, band, fit_band, h, options);
+    if found.is_empty() && local.is_empty() {
         return Ok(None);
     }
     Ok(Some(Stage {
         psd,
         found,
         band: fit_band,
+        local,
     }))
+}
+
+/// The peaks of a sweep's periodogram between the search band's start and the smooth part of
+/// the sweep (`fit_band`), each with the band it is fitted on alone: ± 3 half-power widths
+/// (at least ± 6 bins).
+///
+/// Why alone: near its start a sweep's spectrum is not the smooth ∝ f² of the band (the
+/// chirp's Fresnel ripple, about √r wide, and Klipper's coarse first steps: f rises by
+/// r/(2f) per half period), so one excitation law cannot hold from there to the band's
+/// modes. Over a few half-power widths of a narrow mode it is smooth, and a local power law
+/// stands for it (the joint model of identify/model.rs on that band, one mode). Only peaks
+/// narrower than √r/4 qualify (so the ± 3 widths fitted stay within the scale the excitation
+/// varies on), and the fit must find them resolved (identify/mod.rs). The prominence is read
+/// on the periodogram from its second bin (below the search band too: the spectrum rising
+/// towards a mode near the band's start is its flank, not its base).
+fn start_peaks(
+    psd: &Psd,
+    sweep: Sweep,
+    band: [f64; 2],
+    fit_band: [f64; 2],
+    h: usize,
+    options: &IdentifyOptions,
+) -> Vec<Local> {
+    let df = psd.resolution_hz;
+    let (lo, _) = bins(psd, band);
+    let (fit_lo, fit_hi) = bins(psd, fit_band);
+    if fit_lo <= lo + 2 {
+        return Vec::new();
+    }
+    let peaks = detect_within(
+        psd,
+        [lo, fit_lo - 1],
+        [1, fit_hi],
+        options.min_prominence_db,
+        MAX_MODES,
+        h,
+    );
+    let widest = 0.25 * sweep.rate_hz_per_s.sqrt();
+    let widths = half_powers(
+        psd,
+        &peaks,
+        [df, fit_band[1]],
+        (2 * h + 1) as f64 * df,
+        options,
+    );
+    unique(&peaks, &widths)
+        .into_iter()
+        .filter(|(_, hp)| hp.width_hz <= widest && hp.peak_hz < fit_band[0])
+        .map(|(peak, half)| {
+            let reach = (3.0 * half.width_hz).max(6.0 * df);
+            Local {
+                peak,
+                half,
+                band: [(half.peak_hz - reach).max(df), half.peak_hz + reach],
+            }
+        })
+        .collect()
 }
 
 /// Stage 4: when the recording rings down after a hit, the free-decay fit of every slot's
