@@ -198,11 +198,19 @@ async function inputToFrame(p, events) {
     slider.focus();
     window.__inputToFrame = [];
     // Registered after the page's own listener, so its rAF callback runs after the update.
+    window.__parts = [];
     slider.addEventListener('input', (e) => {
       const since = e.timeStamp;
-      requestAnimationFrame(() => {
+      const heard = performance.now();
+      requestAnimationFrame((frameStart) => {
+        const updated = performance.now();
         const channel = new MessageChannel();
-        channel.port1.onmessage = () => window.__inputToFrame.push(performance.now() - since);
+        channel.port1.onmessage = () => {
+          const end = performance.now();
+          window.__inputToFrame.push(end - since);
+          // To the listener, to the frame's start, the frame's callbacks (the update), the rest.
+          window.__parts.push([heard - since, frameStart - heard, updated - frameStart, end - updated]);
+        };
         channel.port2.postMessage(0);
       });
     });
@@ -212,7 +220,10 @@ async function inputToFrame(p, events) {
     await p.keyboard.press(i % 40 < 20 ? 'ArrowRight' : 'ArrowLeft');
     await p.waitForFunction((n) => window.__inputToFrame.length > n, i, { polling: 'raf' });
   }
-  return p.evaluate(() => window.__inputToFrame);
+  const [times, parts] = await p.evaluate(() => [window.__inputToFrame, window.__parts]);
+  const median = (k) => parts.map((x) => x[k]).sort((a, b) => a - b)[Math.floor(parts.length / 2)].toFixed(1);
+  console.log(`  medians: event to its listener ${median(0)} ms, listener to the frame's start ${median(1)} ms, the frame's callbacks (the update) ${median(2)} ms, then to the end of the frame ${median(3)} ms`);
+  return times;
 }
 
 /** Prints the gzip -9 size of the files at `paths` (URL paths under the repository root). */
