@@ -274,6 +274,19 @@ fn sample(
             }
         }
     }
+    assemble(&dw, &jump, &any_jump, (q, n), period)
+}
+
+/// The command's Taylor state at every sample from what landed between samples (`dw`), and the
+/// state jumps as events (the samples `any_jump` marks, n values each).
+fn assemble(
+    dw: &[f64],
+    jump: &[f64],
+    any_jump: &[bool],
+    (q, n): (usize, usize),
+    period: f64,
+) -> SampledCommand {
+    let samples = any_jump.len();
     // w at the samples: the previous sample's Taylor state shifted by one period, plus what
     // landed in between.
     let mut w = vec![0.0; samples * q];
