@@ -14,9 +14,16 @@
 // per frame, however many input events came). Back-to-back updates with no frame between them
 // pile up the canvases' recorded drawing until the browser rasterises several frames of it
 // inside one update: that gave the 200–500 ms maxima reported before this pacing.
+// Cases: 3 modes (1.2, 3.4, 7.9 Hz) and issue 24's six (1.2 … 34 Hz, ζ 0.02), with the 4
+// shapers, with the first 3 of them (six modes) and with ZVD alone (three); a case the page
+// cannot draw is reported as such. Then input to frame: real key presses on the mismatch
+// slider, each timed from the input event to the end of the frame that shows it (inputToFrame).
 // Run: npm run bench:page   (after npm run build); RUNS=n sets the updates per case (200),
-// SHAPERS=1 or SHAPERS=4 runs only the cases with that many shapers, EXPANDED=1 presses every
-// impulse table's "Show all" first (by default a table longer than 20 rows shows 20).
+// SHAPERS=1|3|4 and MODES=3|6 pick cases, NO_INPUT=1 skips input to frame, EXPANDED=1 presses
+// every impulse table's "Show all" first (by default a table longer than 20 rows shows 20),
+// BEFORE=dir runs every case on the built checkout in dir too (index.html, web/, pkg/; e.g. a
+// `git worktree` of an older commit after its `npm run build`), alternated with this one in
+// blocks, and prints both.
 import { chromium } from 'playwright-core';
 import { readFileSync } from 'node:fs';
 import { gzipSync } from 'node:zlib';
