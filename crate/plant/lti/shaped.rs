@@ -46,10 +46,10 @@ struct ModeBlock {
 impl Lti {
     /// The response to `base` shaped by the convolution of `factors` (each an impulse sequence,
     /// times from 0), at t = k·`sample_period`, k = 0 … `samples` − 1: the same as
-    /// [`Lti::respond`] on `base` shaped by the expanded shaper, to rounding (see the module
-    /// docs). `None` when the plant is not a set of modes driven by the position alone (the
-    /// modal plant), a mode is not underdamped, the sums would grow past [`MAX_GROWTH`], or
-    /// `base` has more than [`MAX_BASE_KNOTS`] knots: then the caller expands the command.
+    /// [`Lti::respond`] on `base` shaped by the expanded shaper, to rounding (the method is
+    /// derived in `crate/plant/lti/shaped.rs`). `None` when the plant is not a set of modes driven by the position alone (the
+    /// modal plant), a mode is not underdamped, the sums would grow past e^300, or
+    /// `base` has more than 64 knots: then the caller expands the command.
     pub fn respond_shaped(
         &self,
         base: &Piecewise,
