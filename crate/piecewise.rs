@@ -150,9 +150,12 @@ impl Piecewise {
                 limit: MAX_KNOTS as f64,
             });
         }
+        // Knot by knot, each followed by every impulse: runs already sorted by time, which the
+        // stable sort in `new` merges instead of sorting the whole (a 6-mode ZVDD shapes a
+        // trapezoid into 4 runs of 4096 knots).
         let mut knots = Vec::with_capacity(n);
-        for imp in shaper.impulses() {
-            for k in &self.knots {
+        for k in &self.knots {
+            for imp in shaper.impulses() {
                 let mut jumps = k.jumps;
                 for j in &mut jumps {
                     *j *= imp.amplitude;

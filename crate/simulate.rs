@@ -5,7 +5,9 @@
 use crate::command::Command;
 use crate::error::{finite, positive, Error, Result};
 use crate::piecewise::Cursor;
+use crate::plant::lti::LtiResponse;
 use crate::plant::Plant;
+use crate::shaper::{Impulse, Shaper};
 use serde::Serialize;
 
 /// Most samples one simulation may produce (memory stays bounded: ~10 signals of this length).
@@ -62,6 +64,48 @@ pub fn sample_count(sample_period: f64, duration: f64) -> Result<usize> {
     Ok(n as usize)
 }
 
+/// [`simulate`] of `command` shaped by `shaper` (the same trajectory, to rounding). On a modal
+/// plant with a piecewise command it is computed from the shaper's convolution factors without
+/// forming the shaped command (`Lti::respond_shaped`): Σ nₖ terms per mode instead of a knot
+/// per impulse of Π nₖ; otherwise the command is shaped and simulated.
+pub fn simulate_shaped(
+    plant: &Plant,
+    command: &Command,
+    shaper: &Shaper,
+    sample_period: f64,
+    duration: f64,
+) -> Result<Trajectory> {
+    if let (Plant::Modal(m), Command::Piecewise(pw)) = (plant, command) {
+        let samples = sample_count(sample_period, duration)?;
+        let factors: Vec<&[Impulse]> = shaper.factors().collect();
+        if let Some(r) = m
+            .to_lti()
+            .respond_shaped(pw, &factors, sample_period, samples)?
+        {
+            let time = (0..samples).map(|k| k as f64 * sample_period).collect();
+            return Ok(lti_trajectory(r, time));
+        }
+    }
+    simulate(plant, &command.shaped(shaper)?, sample_period, duration)
+}
+
+/// The trajectory of a linear plant's response sampled at `time`.
+fn lti_trajectory(r: LtiResponse, time: Vec<f64>) -> Trajectory {
+    let [bp, bv, ba, ep, ev, ea] = r.outputs;
+    let deflection = ep.iter().zip(&bp).map(|(e, b)| e - b).collect();
+    Trajectory {
+        time,
+        base_position: bp,
+        base_velocity: bv,
+        base_acceleration: ba,
+        endpoint: ep,
+        endpoint_velocity: ev,
+        endpoint_acceleration: ea,
+        deflection,
+        swing_angle: None,
+    }
+}
+
 /// Simulates `plant` under `command` from rest, sampled at t = k·`sample_period` for
 /// `duration` seconds. Linear plants are exact at the samples (matrix exponential), the
 /// pendulum is integrated adaptively.
@@ -81,19 +125,7 @@ pub fn simulate(
     };
     if let Some(sys) = lti_plant {
         let r = sys.respond(&pw, sample_period, samples, false)?;
-        let [bp, bv, ba, ep, ev, ea] = r.outputs;
-        let deflection = ep.iter().zip(&bp).map(|(e, b)| e - b).collect();
-        return Ok(Trajectory {
-            time,
-            base_position: bp,
-            base_velocity: bv,
-            base_acceleration: ba,
-            endpoint: ep,
-            endpoint_velocity: ev,
-            endpoint_acceleration: ea,
-            deflection,
-            swing_angle: None,
-        });
+        return Ok(lti_trajectory(r, time));
     }
     let Plant::Pendulum(p) = plant else {
         return Err(Error::invalid("plant", "unsupported plant"));

@@ -21,6 +21,8 @@ use nalgebra::DMatrix;
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
+mod shaped;
+
 /// Number of output rows of an [`Lti`] plant.
 pub const OUTPUTS: usize = 6;
 /// Output row: base position.

@@ -35,6 +35,9 @@ pub(super) struct ShaperResult {
 /// simulated plant, the mismatch or the command: what [`ANALYSIS`] keeps between frames.
 #[derive(Clone)]
 pub(super) struct Analysis {
+    /// Which computation this is (a counter): the same number on every frame that takes it
+    /// from [`ANALYSIS`], so the charts drawn from it alone need not be drawn again.
+    pub generation: u64,
     pub shapers: Vec<Shaper>,
     /// Per shaper, everything but the simulation's metrics (`simulation` is `None`).
     pub results: Vec<ShaperResult>,
@@ -66,6 +69,8 @@ thread_local! {
     /// command or the plant, changes only the simulation: the designs, I(Vtol), V(f), V(ζ),
     /// the map and |S(f)| are taken from here instead of being recomputed every frame.
     static ANALYSIS: RefCell<Option<(AnalysisKey, Analysis)>> = const { RefCell::new(None) };
+    /// The last [`Analysis::generation`] handed out.
+    static GENERATION: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
 /// The designs and their analyses for a frame, from [`ANALYSIS`] when nothing they depend on
@@ -83,7 +88,10 @@ pub(super) fn analysis(frame: &Frame) -> Result<Analysis, Error> {
     let (shapers, results) = designs(frame)?;
     let [damping_chart, map_chart, spectrum_chart] = frame.charts();
     let in_view = |e: Error| e.within("view");
+    let generation = GENERATION.get() + 1;
+    GENERATION.set(generation);
     let a = Analysis {
+        generation,
         damping_curves: damping_chart
             .then(|| damping_curves(frame, &shapers))
             .transpose()

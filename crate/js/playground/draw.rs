@@ -25,6 +25,78 @@ fn backend(canvas: &Option<HtmlCanvasElement>) -> Option<Canvas> {
     canvas.clone().and_then(Canvas::new)
 }
 
+/// The charts drawn from the analysis alone (impulses, V(f), V(ζ), the map, robustness).
+const ANALYSIS_CHARTS: usize = 5;
+
+/// What an analysis chart was last drawn from: the analysis' generation, the canvas (the same
+/// element, at the same size) and the style.
+#[derive(PartialEq)]
+struct Drawn {
+    generation: u64,
+    canvas: HtmlCanvasElement,
+    size: (u32, u32),
+    scale: u64,
+    colors: [(u8, u8, u8); 4],
+}
+
+thread_local! {
+    /// Per analysis chart, what it shows now (`None` after a failed or partial drawing).
+    static DRAWN: std::cell::RefCell<[Option<Drawn>; ANALYSIS_CHARTS]> =
+        const { std::cell::RefCell::new([None, None, None, None, None]) };
+}
+
+/// The backend for analysis chart `slot` on `canvas`, or `None` when the canvas already shows
+/// this analysis in this style (a mismatch, command or plant edit leaves those charts as they
+/// are; a resized canvas is cleared, so its size is part of the check). `done(slot)` records
+/// it once drawn.
+fn analysis_backend(
+    slot: usize,
+    canvas: &Option<HtmlCanvasElement>,
+    frame: &Frame,
+    analysis: &Analysis,
+) -> Option<Canvas> {
+    let element = canvas.as_ref()?;
+    let drawn = Drawn {
+        generation: analysis.generation,
+        canvas: element.clone(),
+        size: (element.width(), element.height()),
+        scale: frame.style.scale.to_bits(),
+        colors: frame.style.colors.map(|c| (c.0, c.1, c.2)),
+    };
+    let same = DRAWN.with_borrow_mut(|d| {
+        let same = d[slot].as_ref() == Some(&drawn);
+        if !same {
+            d[slot] = None;
+        }
+        same
+    });
+    if same {
+        return None;
+    }
+    let backend = backend(canvas);
+    PENDING.with_borrow_mut(|p| p[slot] = backend.is_some().then_some(drawn));
+    backend
+}
+
+thread_local! {
+    /// What each analysis chart is being drawn from, until the frame's drawing succeeded.
+    static PENDING: std::cell::RefCell<[Option<Drawn>; ANALYSIS_CHARTS]> =
+        const { std::cell::RefCell::new([None, None, None, None, None]) };
+}
+
+/// Records the analysis charts drawn in this frame (once every chart drew).
+fn analysis_charts_done() {
+    PENDING.with_borrow_mut(|p| {
+        DRAWN.with_borrow_mut(|d| {
+            for (d, p) in d.iter_mut().zip(p.iter_mut()) {
+                if let Some(p) = p.take() {
+                    *d = Some(p);
+                }
+            }
+        })
+    });
+}
+
 /// Draws every chart the frame has a canvas for.
 pub(super) fn draw(
     frame: &Frame,
@@ -32,9 +104,10 @@ pub(super) fn draw(
     sim: &Simulation,
     extras: &Extras<'_>,
 ) -> Result<(), Error> {
+    PENDING.with_borrow_mut(|p| p.iter_mut().for_each(|x| *x = None));
     analysis_charts(frame, analysis)?;
     simulation_charts(frame, sim, extras.spectra)?;
-    if let Some(b) = backend(&frame.canvases.robustness) {
+    if let Some(b) = analysis_backend(4, &frame.canvases.robustness, frame, analysis) {
         let period = frame.modes[0].damped_period_s();
         let marks: Vec<chart::RobustnessMark<'_>> = analysis
             .results
@@ -53,6 +126,7 @@ pub(super) fn draw(
             &frame.style,
         )?;
     }
+    analysis_charts_done();
     Ok(())
 }
 
@@ -60,7 +134,7 @@ pub(super) fn draw(
 fn analysis_charts(frame: &Frame, analysis: &Analysis) -> Result<(), Error> {
     let (modes, style, vtol) = (&frame.modes, &frame.style, Some(frame.view.vtol));
     let named = |i: usize| frame.labels[i].as_str();
-    if let Some(b) = backend(&frame.canvases.impulses) {
+    if let Some(b) = analysis_backend(0, &frame.canvases.impulses, frame, analysis) {
         let series: Vec<(&str, &Shaper)> = analysis
             .shapers
             .iter()
@@ -69,7 +143,7 @@ fn analysis_charts(frame: &Frame, analysis: &Analysis) -> Result<(), Error> {
             .collect();
         chart::draw_impulses(&b.into_drawing_area(), &series, style)?;
     }
-    if let Some(b) = backend(&frame.canvases.sensitivity) {
+    if let Some(b) = analysis_backend(1, &frame.canvases.sensitivity, frame, analysis) {
         let series: Vec<(&str, &vibration::SensitivityCurve)> = analysis
             .results
             .iter()
@@ -78,7 +152,10 @@ fn analysis_charts(frame: &Frame, analysis: &Analysis) -> Result<(), Error> {
         let modes_hz: Vec<f64> = modes.iter().map(Mode::frequency_hz).collect();
         chart::draw_sensitivity(&b.into_drawing_area(), &series, vtol, &modes_hz, style)?;
     }
-    if let (Some(b), Some(curves)) = (backend(&frame.canvases.damping), &analysis.damping_curves) {
+    if let (Some(b), Some(curves)) = (
+        analysis_backend(2, &frame.canvases.damping, frame, analysis),
+        &analysis.damping_curves,
+    ) {
         let series: Vec<(&str, &vibration::DampingSensitivityCurve)> = curves
             .iter()
             .enumerate()
@@ -87,7 +164,10 @@ fn analysis_charts(frame: &Frame, analysis: &Analysis) -> Result<(), Error> {
         let zetas: Vec<f64> = modes.iter().map(Mode::damping).collect();
         chart::draw_damping_sensitivity(&b.into_drawing_area(), &series, vtol, &zetas, style)?;
     }
-    if let (Some(b), Some(map)) = (backend(&frame.canvases.map), &analysis.map) {
+    if let (Some(b), Some(map)) = (
+        analysis_backend(3, &frame.canvases.map, frame, analysis),
+        &analysis.map,
+    ) {
         let marks: Vec<(f64, f64)> = modes
             .iter()
             .map(|m| (m.frequency_hz(), m.damping()))

@@ -1,7 +1,7 @@
 //! The simulated move of a frame: the reference and every shaped command on the simulated
 //! (mismatched) plant, their metrics, and the commands' spectra.
 
-use super::analysis::Analysis;
+use super::analysis::{own_move, Analysis};
 use super::state::Frame;
 use crate::command::Command;
 use crate::design::ShaperSpec;
@@ -61,7 +61,20 @@ pub(super) fn simulate(frame: &Frame, analysis: &mut Analysis) -> Result<Simulat
         move_metrics(&unshaped, command, command).map_err(|e| e.within("view"))?;
     let mut shaped = Vec::with_capacity(commands.len());
     for (k, c) in commands.iter().enumerate() {
-        let t = sim(c)?;
+        // The reference shaped by a shaper: simulated from the shaper's convolution factors
+        // (the same response to rounding, without a knot per impulse of the expanded shaper).
+        let t = if own_move(&frame.specs[k]) || !matches!(command, Command::Piecewise(_)) {
+            sim(c)?
+        } else {
+            crate::simulate::simulate_shaped(
+                &frame.plant,
+                command,
+                &analysis.shapers[k],
+                sample_period,
+                duration,
+            )
+            .map_err(|e| e.within("view"))?
+        };
         let force = c != command && analysis.shapers[k].centroid_delay().is_none();
         let reference = if force { c } else { command };
         analysis.results[k].simulation =
