@@ -2,7 +2,7 @@
 //! (solid) and as its controller runs it (dashed, same colour), with Vtol and the modes marked
 //! ([`crate::realise`]).
 
-use super::{render_error, ChartStyle, Key, Legend};
+use super::{render_error, ChartStyle, Key};
 use crate::error::Result;
 use crate::vibration::SensitivityCurve;
 use plotters::coord::Shift;
@@ -28,42 +28,15 @@ pub fn draw_realisation<DB: DrawingBackend>(
         (0.0, 1.0),
     );
     let vtol = super::drawable_vtol(vtol);
-    let v_max = all()
-        .flat_map(|c| c.vibration.iter().copied())
-        .filter(|v| v.is_finite())
-        .fold(vtol.unwrap_or(0.0), f64::max)
-        .clamp(1e-3, super::AXIS_LIMIT)
-        * 100.0
-        * 1.06;
+    let v_max = super::curves::v_axis_max(all().flat_map(|c| c.vibration.iter().copied()), vtol);
     let mut chart = super::framed(area, "V(f) designed and as run", 52.0, style)
         .build_cartesian_2d(f_lo..f_hi, 0.0..v_max)
         .map_err(render_error)?;
     super::mesh(&mut chart, "frequency (Hz)", "vibration (%)", style)
         .draw()
         .map_err(render_error)?;
-    let marker = RGBColor(120, 120, 120);
-    for &f in modes_hz.iter().filter(|f| (f_lo..=f_hi).contains(*f)) {
-        chart
-            .draw_series(LineSeries::new(
-                [(f, 0.0), (f, v_max)],
-                marker.stroke_width(style.px(1.0)),
-            ))
-            .map_err(render_error)?;
-    }
-    let mut keys = Legend::default();
-    if let Some(vtol) = vtol {
-        let red = RGBColor(200, 30, 30);
-        chart
-            .draw_series(LineSeries::new(
-                [(f_lo, vtol * 100.0), (f_hi, vtol * 100.0)],
-                red.stroke_width(style.px(1.0)),
-            ))
-            .map_err(render_error)?;
-        keys.push(
-            format!("Vtol {:.3} %", vtol * 100.0),
-            Key::line(red.stroke_width(2)),
-        );
-    }
+    let mut keys =
+        super::curves::marks_and_vtol(&mut chart, modes_hz, vtol, (f_lo, f_hi), v_max, style)?;
     let points = |c: &SensitivityCurve| -> Vec<(f64, f64)> {
         c.frequency_hz
             .iter()

@@ -216,8 +216,9 @@ pub fn quantize_with_report(
     })
 }
 
-/// Times to the nearest multiple of `tick` (impulses on the same tick merge).
-fn round_times(shaper: &Shaper, tick: f64) -> Result<Shaper> {
+/// Times to the nearest multiple of `tick` (impulses on the same tick merge); errors name
+/// `tickS`.
+pub(crate) fn round_times(shaper: &Shaper, tick: f64) -> Result<Shaper> {
     if shaper.duration() / tick > MAX_TICKS {
         return Err(Error::invalid(
             "tickS",

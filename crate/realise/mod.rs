@@ -47,7 +47,7 @@
 
 pub mod definitions;
 
-use crate::design::quantize::{quantize, QuantizeOptions, MAX_AMPLITUDE_STEPS};
+use crate::design::quantize::{quantize, round_times, QuantizeOptions, MAX_AMPLITUDE_STEPS};
 use crate::design::{design_for, DesignRequest, ShaperSpec};
 use crate::error::{positive, Error, Result};
 use crate::firmware_limits::{
@@ -755,7 +755,7 @@ fn generic(ideal: &Shaper, options: &RealiseOptions, changes: &mut Vec<Change>) 
         q.tick_s = period;
         shaper = quantize(&shaper, &q).map_err(|e| rename_field(e, "tickS", "periodS"))?;
     } else if let Some(period) = period {
-        shaper = round_times(&shaper, period)?;
+        shaper = round_times(&shaper, period).map_err(|e| rename_field(e, "tickS", "periodS"))?;
     }
     if let Some(period) = period {
         changes.push(Change {
@@ -770,30 +770,6 @@ fn generic(ideal: &Shaper, options: &RealiseOptions, changes: &mut Vec<Change>) 
         });
     }
     Ok(shaper)
-}
-
-/// Times to the nearest multiple of `period`, amplitudes kept (impulses on the same multiple
-/// merge), as [`crate::design::quantize`] rounds them.
-fn round_times(shaper: &Shaper, period: f64) -> Result<Shaper> {
-    if shaper.duration() / period > 1e12 {
-        return Err(Error::invalid(
-            "periodS",
-            format!(
-                "{period} s is too fine for a {} s shaper",
-                shaper.duration()
-            ),
-        ));
-    }
-    Shaper::new(
-        shaper
-            .impulses()
-            .iter()
-            .map(|imp| Impulse {
-                time: (imp.time / period).round() * period,
-                amplitude: imp.amplitude,
-            })
-            .collect(),
-    )
 }
 
 fn rename_field(e: Error, from: &str, to: &str) -> Error {
