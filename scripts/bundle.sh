@@ -10,11 +10,13 @@
 #                      playground module's (it ranks shapers with the page's module, which
 #                      main.js hands it compiled); started when the first recording is opened;
 #   design_worker.js   web/design_worker.js with the designer module's glue; started when the
-#                      first solved family (si, direct, bounded sampled) is shown.
+#                      first solved family (si, direct, bounded sampled) is shown;
+#   realise_view.js    web/realise_view.js (what a controller runs, issue 23) with the recording
+#                      module's glue; imported by main.js when a shaper is first realised.
 # Each glue finds its .wasm next to the bundle (new URL(…, import.meta.url)), so the bundles
 # live in pkg/page/ with them. Source maps point back to web/. Run by scripts/build.sh after
 # the wasm modules; alone (`npm run build:web`) after editing web/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 common=(--bundle --minify --format=esm --target=es2020 --sourcemap --outdir=pkg/page --log-level=warning)
-node_modules/.bin/esbuild web/main.js web/measure_view.js web/measure_worker.js web/design_worker.js "${common[@]}"
+node_modules/.bin/esbuild web/main.js web/measure_view.js web/measure_worker.js web/design_worker.js web/realise_view.js "${common[@]}"

@@ -5,6 +5,7 @@ import { $, el, fmt, readNumber, COLORS } from './dom.js';
 import { page } from './page.js';
 import { MAX_MODES, MAX_SHAPERS } from './state.js';
 import { COMMAND_PARAMS, parseParam, formatParam } from './params.js';
+import { realiseFields } from './realise.js'; // realisation (issue 23, item 1)
 
 // Frequency sliders are logarithmic: 0.01 Hz … 1 kHz over 0 … 1000.
 const F_MIN = 0.01;
@@ -106,6 +107,7 @@ function shaperCard(spec, k) {
     field('Family', family),
     el('span', { class: 'hint' }, info ? `${info.guarantee}. ${info.source}` : ''),
     ...params,
+    ...realiseFields(spec, k, { field, changed: (c) => page.changed(c), rebuild }), // realisation (issue 23, item 1)
     el('span', { class: 'error group-error', role: 'alert' }));
 }
 

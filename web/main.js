@@ -14,6 +14,7 @@ import { $, el, readNumber, notice, download } from './dom.js';
 import { page } from './page.js';
 import { rebuild, commandFields, clearErrors, showError } from './editors.js';
 import { showResults, showExport } from './results.js';
+import { updateRealisation, withoutRealise } from './realise.js'; // realisation (issue 23, item 1)
 import { scheduler, QUIET_MS, designKey, holding, designerError, forgetFailedLoads, requestDesign, pump, compileModule } from './designs.js';
 
 // ---------- update loop ----------
@@ -59,7 +60,8 @@ function update() {
     response: $('response-chart'), command: $('command-chart'), spectrum: $('spectrum-chart'), robustness: $('robustness-chart'),
   };
   Object.values(canvases).forEach(sizeCanvas);
-  const st = { ...page.state, view: { ...page.state.view, pixelRatio: window.devicePixelRatio || 1 } };
+  // renderPlayground and the designs never see the shapers' realisations (web/realise.js).
+  const st = { ...page.state, shapers: withoutRealise(page.state.shapers), view: { ...page.state.view, pixelRatio: window.devicePixelRatio || 1 } };
   try {
     const { result, kept, left, waiting, waitingKeys } = render(st, canvases);
     page.lastGood = { state: clone(page.state), result, left: left.map((l) => l.index), waiting };
@@ -67,6 +69,8 @@ function update() {
     clearTimeout(scheduler.holdTimer);
     if (!waiting.length) scheduler.dragging = false;
     showResults(result, page.state, kept);
+    // realisation (issue 23, item 1): the view of what each realised shaper's controller runs
+    updateRealisation(page.state, result, kept, { showError, schedule, solvedFamilies: page.solvedFamilies });
     document.body.dataset.ready = 'true';
     left.forEach((l) => showError(l.error));
     showDesigning(waiting, waitingKeys);

@@ -401,8 +401,9 @@ pub fn quantize(
 /// [{ frequencyHz, damping, vibrationIdeal, vibrationRealised }], vtol, insensitivityIdeal,
 /// insensitivityRealised, actsAsHz }`: the shaper `spec` designs as the controller runs it
 /// (crate::realise). Errors in the options (and a firmware that cannot run the design) name
-/// `options.<field>`; errors in the spec name its fields from the root.
-#[cfg(feature = "js-api")]
+/// `options.<field>`; errors in the spec name its fields from the root. Also in the page's
+/// lazily fetched module (`js-recording`), for its realisation view (web/realise.js).
+#[cfg(any(feature = "js-api", feature = "js-recording"))]
 #[wasm_bindgen(js_name = realizeShaper, unchecked_return_type = "Realization")]
 pub fn realize_shaper(
     #[wasm_bindgen(unchecked_param_type = "DesignSpec")] spec: JsValue,

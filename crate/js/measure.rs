@@ -47,7 +47,7 @@ fn recording_error(e: RecordingError) -> JsValue {
 }
 
 /// Options object, `{}` when missing.
-fn options<T: serde::de::DeserializeOwned + Default>(
+pub(super) fn options<T: serde::de::DeserializeOwned + Default>(
     value: JsValue,
     what: &str,
 ) -> Result<T, Error> {
@@ -634,7 +634,7 @@ pub fn draw_spectrum(
 
 /// The canvas's drawing backend and the chart style scaled by `pixel_ratio` (1 when absent or
 /// not a positive number): what both measured-data charts start from.
-fn canvas_and_style(
+pub(super) fn canvas_and_style(
     canvas: HtmlCanvasElement,
     pixel_ratio: Option<f64>,
 ) -> Result<(Canvas, ChartStyle), JsValue> {
@@ -654,7 +654,7 @@ fn canvas_and_style(
 
 /// A `#rrggbb` colour.
 #[cfg(feature = "js-recording")]
-fn css_hex(s: &str) -> Option<RGBColor> {
+pub(super) fn css_hex(s: &str) -> Option<RGBColor> {
     let h = s.strip_prefix('#').filter(|h| h.len() == 6)?;
     let byte = |i: usize| u8::from_str_radix(h.get(i..i + 2)?, 16).ok();
     Some(RGBColor(byte(0)?, byte(2)?, byte(4)?))

@@ -5,6 +5,7 @@
 //!   `renderPlayground` and `exportShaper`);
 //! - [`measure`]: its measured-data part (`parseRecording`, `welch`, `identifyModes`,
 //!   `recommendShaper`, `drawSpectrum`, …);
+//! - [`realise`]: the page's realisation view's chart (`drawRealisation`);
 //! - [`playground`]: the page's frame, `renderPlayground`, in its stages;
 //! - `args`: the exports' arguments checked as what they must be (a string, a number, a
 //!   canvas, an array of numbers), whatever JS passes;
@@ -21,12 +22,15 @@ pub(crate) mod jsde;
 pub mod measure;
 #[cfg(feature = "js-playground")]
 pub mod playground;
+pub mod realise;
 
 // A build with only some of the export groups (Cargo features) may find one of them empty.
 #[allow(unused_imports)]
 pub use api::*;
 #[allow(unused_imports)]
 pub use measure::*;
+#[allow(unused_imports)]
+pub use realise::*;
 #[cfg(feature = "js-playground")]
 pub use playground::render_playground;
 

@@ -270,6 +270,13 @@ export interface Realization {
   sensitivityRealised: SensitivityCurve | null;
 }
 
+/** `drawRealisation`'s data: each shaper's V(f) designed and realised (the page's view). */
+export interface RealisationChartData {
+  shapers: { label: string; color?: string; ideal: SensitivityCurve; realised: SensitivityCurve }[];
+  vtol?: number | null;
+  modesHz?: number[];
+}
+
 // ---------------------------------------------------------------------------------------------
 // Commands, plants, simulation
 
