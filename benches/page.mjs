@@ -46,13 +46,26 @@ const state = {
     command: { kind: 'trapezoid', distance: 1, maxVelocity: 0.75, maxAcceleration: 8 },
   },
 };
-const CASES = [[3, 4, 'mode'], [3, 4, 'mismatch'], [6, 4, 'mode'], [6, 4, 'mismatch'], [6, 3, 'mode'], [6, 3, 'mismatch'], [3, 1, 'mode'], [3, 1, 'mismatch']]
-  .filter(([m, n]) => (!process.env.SHAPERS || Number(process.env.SHAPERS) === n) && (!process.env.MODES || Number(process.env.MODES) === m));
+// Issue 23's realisation view on screen: the 3-mode, 4-shaper case with every shaper realised by
+// a generic controller (1 ms, 64 amplitude steps), and the printer preset (48 Hz: ZV on
+// FT_MOTION, MZV and EI on Klipper, ZVD ideal). REALISE=only runs just these, REALISE=0 none.
+const REALISED = { firmware: 'generic', periodS: 0.001, amplitudeSteps: 64 };
+const CASES = [[3, 4, 'mode'], [3, 4, 'mismatch'], [6, 4, 'mode'], [6, 4, 'mismatch'], [6, 3, 'mode'], [6, 3, 'mismatch'], [3, 1, 'mode'], [3, 1, 'mismatch'],
+  [3, 4, 'mode', 'realised'], [3, 4, 'mismatch', 'realised'], [1, 4, 'mode', 'printer'], [1, 4, 'mismatch', 'printer']]
+  .filter(([m, n]) => (!process.env.SHAPERS || Number(process.env.SHAPERS) === n) && (!process.env.MODES || Number(process.env.MODES) === m))
+  .filter(([, , , view]) => (process.env.REALISE === 'only' ? view : process.env.REALISE === '0' ? !view : true));
 const SHAPED = {
   '3,4': '4 shapers (ZV, ZVD, ZVDD, ZV-D³: 8 … 125 impulses)',
   '6,4': '4 shapers (ZV, ZVD, ZVDD, ZV-D³: 64 … 15625 impulses)',
   '6,3': '3 shapers (ZV, ZVD, ZVDD: 64 … 4096 impulses)',
   '3,1': '1 shaper (ZVD, 27 impulses)',
+  realised: '4 shapers (ZV … ZV-D³) each realised by a generic controller (1 ms, N = 64), the realisation view on screen',
+  printer: 'the printer preset (48 Hz; ZV on FT_MOTION, MZV and EI on Klipper, ZVD), the realisation view on screen',
+};
+const PRINTER = {
+  modes: [{ frequencyHz: 48, damping: 0.07 }],
+  shapers: [{ family: 'zv', realise: { firmware: 'marlinFtMotion' } }, { family: 'mzv', realise: { firmware: 'klipper' } },
+    { family: 'ei', vtol: 0.05, realise: { firmware: 'klipper' } }, { family: 'zvd' }],
 };
 
 const { server, url } = await startServer({ port: 0 });
@@ -70,21 +83,21 @@ try {
   const loaded = fetched.length;
   const builds = [['now', page], ...(before ? [['before', await open(before.url, state, [])]] : [])];
   const charts = await page.$$eval('.charts canvas', (c) => c.length);
-  for (const [modes, shapers, edit] of CASES) {
+  for (const [modes, shapers, edit, view] of CASES) {
     const times = new Map(builds.map(([name]) => [name, []]));
     const failed = new Map();
     for (const [name, p] of builds) {
-      const error = await setCase(p, modes, shapers);
+      const error = await setCase(p, modes, shapers, view);
       if (error) failed.set(name, error);
     }
     // Alternated blocks, so that the machine's swings fall on both builds alike.
     const blocks = before ? 4 : 1;
     for (let b = 0; b < blocks; b++) {
       for (const [name, p] of b % 2 ? [...builds].reverse() : builds) {
-        if (!failed.has(name)) times.get(name).push(...await timed(p, Math.ceil(RUNS / blocks), edit, modes));
+        if (!failed.has(name)) times.get(name).push(...await timed(p, Math.ceil(RUNS / blocks), edit, modes, view === 'printer' ? 48 : 1.2));
       }
     }
-    const what = `full update after a ${edit} edit, ${modes} modes, ${SHAPED[[modes, shapers]]}, ${charts} charts (${RUNS} runs)`;
+    const what = `full update after a ${edit} edit, ${modes} modes, ${SHAPED[view ?? [modes, shapers]]}, ${charts + (view ? 1 : 0)} charts (${RUNS} runs)`;
     for (const [name, t] of times) {
       const tag = before ? `${name.padEnd(6)} ` : '';
       if (failed.has(name)) {
@@ -155,7 +168,11 @@ async function open(base, st, fetched) {
  * Sets the page's modes (3 or 6) and shapers (the 4 of `state`, the first 3 of them, or ZVD
  * alone); returns the page's error message if it cannot draw them.
  */
-async function setCase(p, modes, shapers) {
+async function setCase(p, modes, shapers, view) {
+  let m = modes === 6 ? MODES6 : MODES3;
+  let s = shapers === 1 ? [{ family: 'zvd' }] : state.shapers.slice(0, shapers);
+  if (view === 'realised') s = s.map((x) => ({ ...x, realise: REALISED }));
+  if (view === 'printer') ({ modes: m, shapers: s } = PRINTER);
   const error = await p.evaluate(([m, s]) => {
     const pg = window.__playground;
     pg.state.modes = structuredClone(m);
@@ -163,8 +180,11 @@ async function setCase(p, modes, shapers) {
     pg.state.view.mapShaper = s.length > 1 ? 1 : 0;
     pg.update();
     return [...document.querySelectorAll('.error')].map((x) => x.textContent).filter(Boolean).join('; ');
-  }, [modes === 6 ? MODES6 : MODES3, shapers === 1 ? [{ family: 'zvd' }] : state.shapers.slice(0, shapers)]);
+  }, [m, s]);
   if (error) return error;
+  // The realisation view is fetched when first needed and drawn in the next frame.
+  if (view) await p.waitForSelector('#realisation:not([hidden])', { timeout: 20000 });
+  else await p.waitForSelector('#realisation[hidden]', { state: 'attached', timeout: 20000 });
   if (process.env.EXPANDED) {
     await p.evaluate(() => document.querySelectorAll('.impulses tfoot:not([hidden]) button[aria-expanded="false"]').forEach((b) => b.click()));
   }
@@ -172,7 +192,7 @@ async function setCase(p, modes, shapers) {
 }
 
 /** `runs` full updates after an edit, each in an animation frame of its own (ms each). */
-async function timed(p, runs, edit, modes) {
+async function timed(p, runs, edit, modes, f0 = 1.2) {
   const times = await p.evaluate(async ([n, what, f0]) => {
     const out = [];
     const pg = window.__playground;
@@ -185,7 +205,7 @@ async function timed(p, runs, edit, modes) {
       out.push(pg.update());
     }
     return out;
-  }, [runs, edit, 1.2]);
+  }, [runs, edit, f0]);
   const errors = await p.$$eval('.error', (e) => e.map((x) => x.textContent).filter(Boolean));
   if (errors.length) throw new Error(`page errors during the benchmark (${modes} modes): ${errors.join('; ')}`);
   return times;

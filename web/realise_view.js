@@ -15,7 +15,7 @@ const $ = (id) => document.getElementById(id);
 /** The compared shapers' colours (web/dom.js's COLORS; this bundle has its own copy). */
 const COLORS = ['#0072b2', '#d55e00', '#009e73', '#cc79a7'];
 /** Points of each V(f) curve. */
-const POINTS = 301;
+const POINTS = 201;
 
 let started = null;
 /** Instantiates the recording module (once). */
@@ -24,8 +24,30 @@ export function ready() {
   return started;
 }
 
-/** The last good realisation of each shaper, by a key of what it was computed from. */
+/** The last good realisation of each shaper: `{ key, r, label }`, `key` what it was computed
+ * from (an edit that changes none of it, the mismatch say, reuses it). */
 const lastGood = new Map();
+/** What the chart last drew (its data and size, as JSON): unchanged, it is not drawn again. */
+let drawnKey = '';
+
+// The chart's CSS size, kept by a ResizeObserver (as main.js does for the other charts): reading
+// clientWidth in update() would lay the whole page out again, the tables' texts having changed.
+let chartSize = null;
+let observer = null;
+function sizeOf(canvas, schedule) {
+  if (!chartSize) {
+    chartSize = [canvas.clientWidth, canvas.clientHeight];
+    observer = typeof ResizeObserver === 'function' ? new ResizeObserver(() => {
+      const next = [canvas.clientWidth, canvas.clientHeight];
+      if (next[0] !== chartSize[0] || next[1] !== chartSize[1]) {
+        chartSize = next;
+        schedule();
+      }
+    }) : null;
+    observer?.observe(canvas);
+  }
+  return chartSize;
+}
 
 const fmt = (x, digits = 4) => (Number.isFinite(x) ? String(Number(x.toPrecision(digits))) : '—');
 const pct = (v) => (Number.isFinite(v) ? (Math.abs(v) < 1e-11 ? '≈ 0' : fmt(v * 100, 3)) : '—');
@@ -75,12 +97,16 @@ export function update(st, result, kept, hooks) {
     const spec = st.shapers[k];
     if (!isRealised(spec)) return;
     const solved = hooks.solvedFamilies.has(spec.family);
-    let r;
-    try {
-      r = realizeShaper(specOf(st, k, result.results[j], solved), optionsOf(spec.realise, st, curve));
-      lastGood.set(k, { r, label: result.results[j].label });
-    } catch (e) {
-      hooks.showError(renamed(e, k));
+    const args = [specOf(st, k, result.results[j], solved), optionsOf(spec.realise, st, curve)];
+    const key = JSON.stringify(args);
+    if (lastGood.get(k)?.key !== key || lastGood.get(k)?.failed) {
+      try {
+        lastGood.set(k, { key, r: realizeShaper(...args), label: result.results[j].label });
+      } catch (e) {
+        hooks.showError(renamed(e, k));
+        const last = lastGood.get(k);
+        if (last) last.failed = true;
+      }
     }
     const good = lastGood.get(k);
     if (good) shown.push({ k, ...good });
@@ -88,16 +114,20 @@ export function update(st, result, kept, hooks) {
   for (const k of [...lastGood.keys()]) if (!(k < st.shapers.length) || !isRealised(st.shapers[k])) lastGood.delete(k);
   if (section.hidden !== !shown.length) section.hidden = !shown.length;
   if (!shown.length) return;
-  drawChart(st, shown);
+  drawChart(st, shown, hooks.schedule);
   showSummaries(shown);
   showTable(st, shown);
 }
 
-function drawChart(st, shown) {
+function drawChart(st, shown, schedule) {
   const canvas = $('realisation-chart');
   const ratio = window.devicePixelRatio || 1;
-  const w = Math.max(1, Math.round(canvas.clientWidth * ratio));
-  const h = Math.max(1, Math.round(canvas.clientHeight * ratio));
+  const [cw, ch] = sizeOf(canvas, schedule);
+  const w = Math.max(1, Math.round(cw * ratio));
+  const h = Math.max(1, Math.round(ch * ratio));
+  const key = JSON.stringify([w, h, st.view.vtol, st.modes, shown.map(({ k, key: of, label }) => [k, of, label])]);
+  if (key === drawnKey) return;
+  drawnKey = key;
   if (canvas.width !== w || canvas.height !== h) {
     canvas.width = w;
     canvas.height = h;
