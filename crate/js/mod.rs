@@ -29,10 +29,10 @@ pub mod realise;
 pub use api::*;
 #[allow(unused_imports)]
 pub use measure::*;
-#[allow(unused_imports)]
-pub use realise::*;
 #[cfg(feature = "js-playground")]
 pub use playground::render_playground;
+#[allow(unused_imports)]
+pub use realise::*;
 
 // The TypeScript types the exports' signatures name (`unchecked_param_type`,
 // `unchecked_return_type`), appended to the `.d.ts` of every module: the hand-written ones of
