@@ -156,7 +156,7 @@ function showSummaries(shown) {
     li.dataset.shaper = String(k);
     li.children[0].style.background = COLORS[k % COLORS.length];
     setText(li.children[1], `Shaper ${k + 1} (${label}) on ${title(r.firmware)}`);
-    setText(li.childNodes[2], r.runs === 'custom' ? ', as a custom shaper: ' : `, as its ${r.runs}: `);
+    setText(li.childNodes[2], r.runs === 'custom' ? ', as a custom shaper: ' : `, as its ${r.runs.toUpperCase()}: `);
     setText(li.lastChild, r.summary);
   });
 }

@@ -22,6 +22,7 @@ pub(crate) mod jsde;
 pub mod measure;
 #[cfg(feature = "js-playground")]
 pub mod playground;
+#[cfg(any(feature = "js-api", feature = "js-recording"))]
 pub mod realise;
 
 // A build with only some of the export groups (Cargo features) may find one of them empty.
@@ -31,7 +32,7 @@ pub use api::*;
 pub use measure::*;
 #[cfg(feature = "js-playground")]
 pub use playground::render_playground;
-#[allow(unused_imports)]
+#[cfg(any(feature = "js-api", feature = "js-recording"))]
 pub use realise::*;
 
 // The TypeScript types the exports' signatures name (`unchecked_param_type`,

@@ -2,7 +2,6 @@
 //! returned for each compared shaper — V(f) designed and as the controller runs it — with
 //! [`crate::chart::draw_realisation`]. In the lazily fetched module (`js-recording`), with
 //! `realizeShaper`, so the page's first load does not carry the realisation code.
-#![cfg(any(feature = "js-api", feature = "js-recording"))]
 
 use super::api::{from_js, js_error};
 use super::args;
