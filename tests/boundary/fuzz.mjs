@@ -149,6 +149,8 @@ function exportsTable(env) {
     { name: 'drawSpectrum', names: ['canvas', 'spectrum', 'options'], canvas: true, args: () => [env.canvas(), spectrum(), { peaksHz: [40] }] },
     // Its data's fields are named by their keys (`frequencyHz`, `shapers[0].values`), as documented.
     { name: 'drawKlipperChart', names: ['canvas', 'data', 'options'], canvas: true, aliases: { data: ['frequencyHz', 'psdSum', 'psdX', 'psdY', 'psdZ', 'after', 'shapers'] }, args: () => { const s = spectrum(); return [env.canvas(), { frequencyHz: s.frequencyHz, psdSum: s.psd }, { maxHz: 150 }]; } },
+    // The realisation chart (issue 23): the two curves per shaper are realizeShaper's.
+    { name: 'drawRealisation', names: ['canvas', 'data', 'options'], canvas: true, aliases: { data: ['shapers', 'vtol', 'modesHz'] }, args: () => [env.canvas(), { shapers: [{ label: 'ZV', color: '#0072b2', ideal: { frequencyHz: [0, 30, 60, 90], vibration: [1, 0.5, 0, 0.5] }, realised: { frequencyHz: [0, 30, 60, 90], vibration: [1, 0.45, 0.06, 0.55] } }], vtol: 0.05, modesHz: [60] }, { pixelRatio: 1 }] },
     // The class: its constructor, and its methods on a live parser (a new one after `finish`).
     { name: 'new RecordingParser', names: ['options'], cls: 'new', args: () => [{ fileName: 'x.csv' }] },
     { name: 'RecordingParser.push', names: ['chunk'], aliases: { chunk: ['recording'] }, cls: 'push', args: () => [text.slice(0, text.indexOf('\n', 200) + 1)] },
