@@ -99,9 +99,11 @@ export function update(st, result, kept, hooks) {
     const solved = hooks.solvedFamilies.has(spec.family);
     const args = [specOf(st, k, result.results[j], solved), optionsOf(spec.realise, st, curve)];
     const key = JSON.stringify(args);
+    // Another shaper now at k (one before it was removed): its last good is not this one's.
+    if (lastGood.get(k) && lastGood.get(k).family !== spec.family) lastGood.delete(k);
     if (lastGood.get(k)?.key !== key || lastGood.get(k)?.failed) {
       try {
-        lastGood.set(k, { key, r: realizeShaper(...args), label: result.results[j].label });
+        lastGood.set(k, { key, family: spec.family, r: realizeShaper(...args), label: result.results[j].label });
       } catch (e) {
         hooks.showError(renamed(e, k));
         const last = lastGood.get(k);
