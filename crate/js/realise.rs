@@ -5,7 +5,7 @@
 
 use super::api::{from_js, js_error};
 use super::args;
-use super::measure::{canvas_and_style, css_hex, options};
+use super::measure::{canvas_and_style, css_hex, options as read_options};
 use crate::chart;
 use crate::vibration::SensitivityCurve;
 use plotters::prelude::IntoDrawingArea;
@@ -51,11 +51,11 @@ pub fn draw_realisation(
     #[wasm_bindgen(unchecked_param_type = "HTMLCanvasElement")] canvas: JsValue,
     #[wasm_bindgen(unchecked_param_type = "RealisationChartData")] data: JsValue,
     #[wasm_bindgen(unchecked_optional_param_type = "{ pixelRatio?: number } | null")]
-    draw_options: JsValue,
+    options: JsValue,
 ) -> Result<(), JsValue> {
     let canvas = args::canvas(canvas, "canvas").map_err(js_error)?;
     let data: Data = from_js(data, "data").map_err(js_error)?;
-    let o: DrawOptions = options(draw_options, "options").map_err(js_error)?;
+    let o: DrawOptions = read_options(options, "options").map_err(js_error)?;
     let (backend, mut style) = canvas_and_style(canvas, o.pixel_ratio)?;
     for (slot, entry) in style.colors.iter_mut().zip(&data.shapers) {
         if let Some(c) = entry.color.as_deref().and_then(css_hex) {
