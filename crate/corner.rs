@@ -417,12 +417,43 @@ fn ringing_after(wall: &Segment, time: &[f64], nozzle: &[Vec<f64>; 2], lag: f64)
 
 /// A square of side `side` (mm) from the origin, counter-clockwise, back to the start.
 pub fn square(side: f64) -> Result<Vec<[f64; 2]>> {
-    positive("side", side)?;
+    positive("sideMm", side)?;
     Ok(vec![
         [0.0, 0.0],
         [side, 0.0],
         [side, side],
         [0.0, side],
+        [0.0, 0.0],
+    ])
+}
+
+/// Klipper's ringing tower's outline (docs/Resonance_Compensation.md prints
+/// docs/prints/ringing_tower.stl, "the ringing test model"): an L of two walls, each `side` mm
+/// long (120 in the model) and `thickness` mm thick (8), standing on the X and Y axes, so that
+/// each wall rings with one axis. A slicer's outer perimeter of it is this closed polygon:
+/// from the origin along +X, around the end of the X wall, back along the inner face to the
+/// inner (concave) corner, up the inner face of the Y wall, around its end and down its outer
+/// face to the origin — five convex 90° corners and one concave. Read off the model's vertices
+/// at z = 0 (its footprint spans 0…120 mm in X and Y; the inner faces are at x = 8 and
+/// y = 8); the model's notches on the inner faces, its X and Y marks and its 0.15 mm smoothing
+/// gap, there to make ringing and smoothing visible on a print, are left out.
+pub fn ringing_tower(side: f64, thickness: f64) -> Result<Vec<[f64; 2]>> {
+    positive("sideMm", side)?;
+    positive("thicknessMm", thickness)?;
+    if thickness >= side {
+        return Err(Error::invalid(
+            "thicknessMm",
+            format!("must be less than sideMm ({side} mm), got {thickness}"),
+        ));
+    }
+    let (l, w) = (side, thickness);
+    Ok(vec![
+        [0.0, 0.0],
+        [l, 0.0],
+        [l, w],
+        [w, w],
+        [w, l],
+        [0.0, l],
         [0.0, 0.0],
     ])
 }
