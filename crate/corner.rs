@@ -375,6 +375,42 @@ fn signed_distance(s: &Segment, p: [f64; 2]) -> f64 {
     off[0].hypot(off[1]).copysign(cross)
 }
 
+/// The point of the path nearest to `p` (the foot on the nearest segment).
+fn nearest_foot(segments: &[Segment], p: [f64; 2]) -> [f64; 2] {
+    let mut best = (f64::INFINITY, p);
+    for s in segments {
+        let rel = [p[0] - s.start[0], p[1] - s.start[1]];
+        let along = (rel[0] * s.direction[0] + rel[1] * s.direction[1]).clamp(0.0, s.length);
+        let foot = [
+            s.start[0] + along * s.direction[0],
+            s.start[1] + along * s.direction[1],
+        ];
+        let d = (p[0] - foot[0]).hypot(p[1] - foot[1]);
+        if d < best.0 {
+            best = (d, foot);
+        }
+    }
+    best.1
+}
+
+impl Print {
+    /// The nozzle's track as a print would show it with the deviation magnified: each sample's
+    /// nearest point on the path plus `factor` times the nozzle's offset from it (mm; X, Y).
+    /// `factor` 1 is the nozzle itself.
+    pub fn magnified(&self, plan: &Plan, factor: f64) -> Result<[Vec<f64>; 2]> {
+        finite("magnify", factor)?;
+        let n = self.time.len();
+        let (mut xs, mut ys) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for i in 0..n {
+            let p = [self.nozzle[0][i], self.nozzle[1][i]];
+            let foot = nearest_foot(&plan.segments, p);
+            xs.push(foot[0] + factor * (p[0] - foot[0]));
+            ys.push(foot[1] + factor * (p[1] - foot[1]));
+        }
+        Ok([xs, ys])
+    }
+}
+
 fn nearest_signed_distance(segments: &[Segment], p: [f64; 2]) -> f64 {
     segments
         .iter()

@@ -340,3 +340,117 @@ fn the_ringing_tower_rings_each_wall_with_one_axis() {
         2.0 * half
     );
 }
+
+/// The JSON spec (what `simulateCorner` takes): the same prints as the core calls, the shaped
+/// print only when an axis has a shaper, the magnified track through the nozzle at ×1, and each
+/// bad field named from the spec's root.
+#[test]
+fn the_corner_spec_is_the_core_calls() {
+    use input_shaping::scenario::{corner_for, CornerSpec};
+    let spec = |text: &str| -> CornerSpec { serde_json::from_str(text).unwrap() };
+    let base = r#""path":{"kind":"square","sideMm":30},"velocity":120,"accel":4000,
+        "x":{"modes":[{"frequencyHz":42,"damping":0.06}],"shaper":{"family":"zvd"}},
+        "y":{"modes":[{"frequencyHz":55,"damping":0.05}]},"samplePeriodS":0.0002"#;
+    let r = corner_for(&spec(&format!("{{{base},\"magnify\":1}}"))).unwrap();
+    let p = plan(&square(30.0).unwrap(), &limits(120.0, 4000.0, 5.0)).unwrap();
+    assert_eq!(r.segments, p.segments);
+    let (xp, yp) = (plant(42.0, 0.06), plant(55.0, 0.05));
+    let sx = zvd(&Mode::new(42.0, 0.06).unwrap()).unwrap();
+    fn axes<'a>(x: &'a ModalPlant, y: &'a ModalPlant, s: Option<&'a Shaper>) -> [Axis<'a>; 2] {
+        [
+            Axis {
+                plant: x,
+                shaper: s,
+            },
+            Axis {
+                plant: y,
+                shaper: None,
+            },
+        ]
+    }
+    let unshaped = corner(&p, axes(&xp, &yp, None), 2e-4, 0.05).unwrap();
+    let shaped = corner(&p, axes(&xp, &yp, Some(&sx)), 2e-4, 0.05).unwrap();
+    assert_eq!(r.unshaped.print, unshaped);
+    assert_eq!(r.shaped.as_ref().unwrap().print, shaped);
+    assert!(r.shaper_y.is_none() && r.shaper_x.is_some());
+    let drawn = r.unshaped.drawn.as_ref().unwrap();
+    for i in 0..unshaped.time.len() {
+        assert!((drawn[0][i] - unshaped.nozzle[0][i]).abs() < 1e-9);
+        assert!((drawn[1][i] - unshaped.nozzle[1][i]).abs() < 1e-9);
+    }
+    // ×k moves each drawn point k times as far from the path: its distance is k·|deviation|.
+    let r10 = corner_for(&spec(&format!("{{{base},\"magnify\":10}}"))).unwrap();
+    let d10 = r10.unshaped.drawn.unwrap();
+    let i = unshaped
+        .deviation
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .unwrap()
+        .0;
+    let foot_offset = |k: f64, d: &[Vec<f64>; 2]| {
+        ((d[0][i] - unshaped.nozzle[0][i]).hypot(d[1][i] - unshaped.nozzle[1][i])) / (k - 1.0)
+    };
+    assert!(
+        (foot_offset(10.0, &d10) - unshaped.deviation[i].abs()).abs() < 1e-9,
+        "{} vs {}",
+        foot_offset(10.0, &d10),
+        unshaped.deviation[i]
+    );
+    assert!(r10.unshaped.print.corners.len() == 3 && r.unshaped.drawn.is_some());
+    let plain = corner_for(&spec(
+        r#"{"path":{"kind":"ringingTower"},"velocity":100,"accel":3000,
+        "x":{"modes":[{"frequencyHz":42}]},"y":{"modes":[{"frequencyHz":55}]}}"#,
+    ))
+    .unwrap();
+    assert!(plain.shaped.is_none() && plain.unshaped.drawn.is_none());
+    assert_eq!(plain.unshaped.print.corners.len(), 5);
+    assert!(plain.sample_period_s <= 1.0 / (25.0 * 55.0) + 1e-15);
+    let field = |text: &str| {
+        corner_for(&spec(text))
+            .unwrap_err()
+            .field()
+            .map(str::to_owned)
+    };
+    let axes_ok = r#""x":{"modes":[{"frequencyHz":42}]},"y":{"modes":[{"frequencyHz":55}]}"#;
+    for (bad, name) in [
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":0}},"velocity":1,"accel":1,{axes_ok}}}"#),
+            "path.sideMm",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"ringingTower","thicknessMm":130}},"velocity":1,"accel":1,{axes_ok}}}"#),
+            "path.thicknessMm",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":0,"accel":1,{axes_ok}}}"#),
+            "velocity",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":1,"accel":1,"squareCornerVelocity":-1,{axes_ok}}}"#),
+            "squareCornerVelocity",
+        ),
+        (
+            r#"{"path":{"kind":"square","sideMm":9},"velocity":1,"accel":1,"x":{"modes":[{"frequencyHz":-1}]},"y":{"modes":[{"frequencyHz":55}]}}"#.to_string(),
+            "x.modes[0].frequencyHz",
+        ),
+        (
+            r#"{"path":{"kind":"square","sideMm":9},"velocity":1,"accel":1,"x":{"modes":[{"frequencyHz":42}]},"y":{"modes":[{"frequencyHz":55}],"shaper":{"family":"ei","vtol":2}}}"#.to_string(),
+            "y.shaper.vtol",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":1,"accel":1,{axes_ok},"samplePeriodS":1e-9}}"#),
+            "samplePeriodS",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":1,"accel":1,{axes_ok},"settleS":-1}}"#),
+            "settleS",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":1,"accel":1,{axes_ok},"magnify":0}}"#),
+            "magnify",
+        ),
+    ] {
+        assert_eq!(field(&bad).as_deref(), Some(name), "{bad}");
+    }
+}
