@@ -486,7 +486,10 @@ pub fn corner_for(spec: &CornerSpec) -> Result<CornerResult> {
     let settle = spec.settle_s.unwrap_or(0.05);
     finite("settleS", settle)?;
     if settle < 0.0 {
-        return Err(Error::invalid("settleS", format!("must be ≥ 0 s, got {settle}")));
+        return Err(Error::invalid(
+            "settleS",
+            format!("must be ≥ 0 s, got {settle}"),
+        ));
     }
     let total = planned.duration() + settle;
     let sample_period = match spec.sample_period_s {

@@ -347,7 +347,10 @@ fn simulate_corner_is_the_rust_result() {
     assert_eq!(corners.length(), 5);
     for (bad, field) in [
         (r#""path":{"kind":"square","sideMm":-1}"#, "path.sideMm"),
-        (r#""path":{"kind":"ringingTower","thicknessMm":200}"#, "path.thicknessMm"),
+        (
+            r#""path":{"kind":"ringingTower","thicknessMm":200}"#,
+            "path.thicknessMm",
+        ),
     ] {
         let spec = format!(
             r#"{{{bad},"velocity":100,"accel":3000,"x":{{"modes":[{{"frequencyHz":42}}]}},"y":{{"modes":[{{"frequencyHz":55}}]}}}}"#
