@@ -462,87 +462,132 @@ pub struct CornerResult {
     pub shaper_y: Option<ShaperData>,
 }
 
+/// A corner spec made ready to print: the plan, the axes' plants and shapers, the sampling.
+pub struct CornerSetup {
+    /// The planned path.
+    pub plan: crate::corner::Plan,
+    /// X's and Y's plants.
+    pub plants: [crate::plant::ModalPlant; 2],
+    /// X's and Y's shapers from the spec.
+    pub shapers: [Option<Shaper>; 2],
+    /// Sample period (s).
+    pub sample_period: f64,
+    /// Time simulated after the path ends (s).
+    pub settle: f64,
+    /// The magnification of the drawn track, if asked for.
+    pub magnify: Option<f64>,
+}
+
+impl CornerSetup {
+    /// Validates and plans `spec` (errors named from its root) and designs its shapers.
+    pub fn new(spec: &CornerSpec) -> Result<Self> {
+        use crate::corner::{plan, MotionLimits};
+        use crate::plant::ModalPlant;
+        let points = spec.path.points().map_err(|e| e.within("path"))?;
+        let limits = MotionLimits {
+            velocity: spec.velocity,
+            accel: spec.accel,
+            square_corner_velocity: spec.square_corner_velocity,
+        };
+        let planned = plan(&points, &limits)?;
+        let axis = |a: &CornerAxisSpec, name: &str| -> Result<(ModalPlant, Option<Shaper>)> {
+            let plant = ModalPlant::from_spec(&a.modes).map_err(|e| e.within(name))?;
+            let shaper = resolve_shaper(&a.shaper, &a.impulses, || Ok(plant.modes().to_vec()))
+                .map_err(|e| e.within(name))?;
+            Ok((plant, shaper))
+        };
+        let (px, sx) = axis(&spec.x, "x")?;
+        let (py, sy) = axis(&spec.y, "y")?;
+        let settle = spec.settle_s.unwrap_or(0.05);
+        finite("settleS", settle)?;
+        if settle < 0.0 {
+            return Err(Error::invalid(
+                "settleS",
+                format!("must be ≥ 0 s, got {settle}"),
+            ));
+        }
+        let total = planned.duration() + settle;
+        let sample_period = match spec.sample_period_s {
+            Some(t) => positive("samplePeriodS", t)?,
+            None => {
+                let fastest = px
+                    .modes()
+                    .iter()
+                    .chain(py.modes())
+                    .map(Mode::frequency_hz)
+                    .fold(0.0_f64, f64::max);
+                (1.0 / (25.0 * fastest))
+                    .min(1e-3)
+                    .max(total / (CORNER_SAMPLES - 1) as f64)
+            }
+        };
+        sample_count(sample_period, total).map_err(|e| match e {
+            Error::TooLarge { value, limit, .. } => Error::TooLarge {
+                field: "samplePeriodS".into(),
+                value,
+                limit,
+            },
+            other => other,
+        })?;
+        let magnify = spec.magnify.map(|m| positive("magnify", m)).transpose()?;
+        Ok(CornerSetup {
+            plan: planned,
+            plants: [px, py],
+            shapers: [sx, sy],
+            sample_period,
+            settle,
+            magnify,
+        })
+    }
+
+    /// The print with X shaped by `x` and Y by `y` (`None`: unshaped).
+    pub fn print(&self, x: Option<&Shaper>, y: Option<&Shaper>) -> Result<PrintResult> {
+        use crate::corner::{corner, Axis};
+        let axes = [
+            Axis {
+                plant: &self.plants[0],
+                shaper: x,
+            },
+            Axis {
+                plant: &self.plants[1],
+                shaper: y,
+            },
+        ];
+        let print = corner(&self.plan, axes, self.sample_period, self.settle)?;
+        let drawn = self
+            .magnify
+            .map(|m| print.magnified(&self.plan, m))
+            .transpose()?;
+        Ok(PrintResult { print, drawn })
+    }
+
+    /// The shaper `spec` designed for X's modes and for Y's (errors named `x.…`, `y.…`).
+    pub fn design_per_axis(&self, spec: &ShaperSpec) -> Result<[Shaper; 2]> {
+        let x = design_for(spec, self.plants[0].modes()).map_err(|e| e.within("x"))?;
+        let y = design_for(spec, self.plants[1].modes()).map_err(|e| e.within("y"))?;
+        Ok([x, y])
+    }
+}
+
 /// Plans a corner spec's path, designs each axis's shaper, and prints the path unshaped and
 /// shaped ([`crate::corner`]). Errors name the field from the spec's root (`path.sideMm`,
 /// `x.modes[0].frequencyHz`, `y.shaper.family`, `squareCornerVelocity`).
 pub fn corner_for(spec: &CornerSpec) -> Result<CornerResult> {
-    use crate::corner::{corner, plan, Axis, MotionLimits};
-    use crate::plant::ModalPlant;
-    let points = spec.path.points().map_err(|e| e.within("path"))?;
-    let limits = MotionLimits {
-        velocity: spec.velocity,
-        accel: spec.accel,
-        square_corner_velocity: spec.square_corner_velocity,
-    };
-    let planned = plan(&points, &limits)?;
-    let axis = |a: &CornerAxisSpec, name: &str| -> Result<(ModalPlant, Option<Shaper>)> {
-        let plant = ModalPlant::from_spec(&a.modes).map_err(|e| e.within(name))?;
-        let shaper = resolve_shaper(&a.shaper, &a.impulses, || Ok(plant.modes().to_vec()))
-            .map_err(|e| e.within(name))?;
-        Ok((plant, shaper))
-    };
-    let (px, sx) = axis(&spec.x, "x")?;
-    let (py, sy) = axis(&spec.y, "y")?;
-    let settle = spec.settle_s.unwrap_or(0.05);
-    finite("settleS", settle)?;
-    if settle < 0.0 {
-        return Err(Error::invalid(
-            "settleS",
-            format!("must be ≥ 0 s, got {settle}"),
-        ));
-    }
-    let total = planned.duration() + settle;
-    let sample_period = match spec.sample_period_s {
-        Some(t) => positive("samplePeriodS", t)?,
-        None => {
-            let fastest = px
-                .modes()
-                .iter()
-                .chain(py.modes())
-                .map(Mode::frequency_hz)
-                .fold(0.0_f64, f64::max);
-            (1.0 / (25.0 * fastest))
-                .min(1e-3)
-                .max(total / (CORNER_SAMPLES - 1) as f64)
-        }
-    };
-    sample_count(sample_period, total).map_err(|e| match e {
-        Error::TooLarge { value, limit, .. } => Error::TooLarge {
-            field: "samplePeriodS".into(),
-            value,
-            limit,
-        },
-        other => other,
-    })?;
-    let magnify = spec.magnify.map(|m| positive("magnify", m)).transpose()?;
-    let print = |x: Option<&Shaper>, y: Option<&Shaper>| -> Result<PrintResult> {
-        let axes = [
-            Axis {
-                plant: &px,
-                shaper: x,
-            },
-            Axis {
-                plant: &py,
-                shaper: y,
-            },
-        ];
-        let print = corner(&planned, axes, sample_period, settle)?;
-        let drawn = magnify.map(|m| print.magnified(&planned, m)).transpose()?;
-        Ok(PrintResult { print, drawn })
-    };
-    let unshaped = print(None, None)?;
+    let setup = CornerSetup::new(spec)?;
+    let [sx, sy] = &setup.shapers;
+    let unshaped = setup.print(None, None)?;
     let shaped = if sx.is_some() || sy.is_some() {
-        Some(print(sx.as_ref(), sy.as_ref())?)
+        Some(setup.print(sx.as_ref(), sy.as_ref())?)
     } else {
         None
     };
     Ok(CornerResult {
-        duration: planned.duration(),
-        segments: planned.segments,
-        sample_period_s: sample_period,
+        duration: setup.plan.duration(),
+        sample_period_s: setup.sample_period,
         unshaped,
         shaped,
-        shaper_x: sx.map(|s| s.to_data()),
-        shaper_y: sy.map(|s| s.to_data()),
+        shaper_x: sx.as_ref().map(Shaper::to_data),
+        shaper_y: sy.as_ref().map(Shaper::to_data),
+        segments: setup.plan.segments,
     })
 }

@@ -360,7 +360,7 @@ fn simulate_corner_is_the_rust_result() {
     }
     let (message, got) = error_message(
         wasm::simulate_corner(js(r#"{"path":{"kind":"square","sideMm":10},"velocity":100,"accel":3000,
-            "x":{"modes":[{"frequencyHz":-42}]},"y":{"modes":[{"frequencyHz":55}],"shaper":{"family":"nope"}}}"#))
+            "x":{"modes":[{"frequencyHz":-42}]},"y":{"modes":[{"frequencyHz":55}],"shaper":{"family":"zv"}}}"#))
         .unwrap_err(),
     );
     assert_eq!(got.as_deref(), Some("x.modes[0].frequencyHz"), "{message}");

@@ -5,6 +5,7 @@
 //!   `renderPlayground` and `exportShaper`);
 //! - [`measure`]: its measured-data part (`parseRecording`, `welch`, `identifyModes`,
 //!   `recommendShaper`, `drawSpectrum`, …);
+//! - `corner`: the page's printed-corner view, `renderCorner` (feature `js-corner`);
 //! - [`playground`]: the page's frame, `renderPlayground`, in its stages;
 //! - `args`: the exports' arguments checked as what they must be (a string, a number, a
 //!   canvas, an array of numbers), whatever JS passes;
@@ -17,6 +18,8 @@
 pub mod api;
 pub(crate) mod args;
 pub(crate) mod canvas;
+#[cfg(feature = "js-corner")]
+pub mod corner;
 pub(crate) mod jsde;
 pub mod measure;
 #[cfg(feature = "js-playground")]
@@ -25,6 +28,8 @@ pub mod playground;
 // A build with only some of the export groups (Cargo features) may find one of them empty.
 #[allow(unused_imports)]
 pub use api::*;
+#[cfg(feature = "js-corner")]
+pub use corner::render_corner;
 #[allow(unused_imports)]
 pub use measure::*;
 #[cfg(feature = "js-playground")]
