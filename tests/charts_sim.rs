@@ -494,3 +494,26 @@ fn corner_chart_draws_the_magnified_walls_on_equal_scales() {
         "unshaped {ringing} px, ZV {straight} px"
     );
 }
+
+/// A track magnified beyond reason (or not finite) still draws: no panic, axes within reach.
+#[test]
+fn corner_chart_survives_absurd_tracks() {
+    use input_shaping::chart::draw_corner;
+    let points = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]];
+    let wild = [
+        vec![0.0, 1e308, -1e308, f64::NAN, f64::INFINITY],
+        vec![0.0, -1e308, 1e308, 1.0, 2.0],
+    ];
+    let out = svg(|a| {
+        draw_corner(
+            a,
+            &points,
+            Some(&wild),
+            &[("x", &wild)],
+            1e300,
+            &ChartStyle::default(),
+        )
+        .unwrap()
+    });
+    assert!(out.contains("<polyline"));
+}

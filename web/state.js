@@ -9,6 +9,8 @@
 //                         maxAcceleration?, maxJerk? },
 //              plant: { kind: 'modal' } | { kind: 'pendulum', gravity?, initialAngle? },
 //              mapShaper }                       which shaper the frequency × damping map shows
+//   corner?: { open, path: 'square' | 'ringingTower', sideMm, velocity, accel, scv, magnify,
+//              x: [{ frequencyHz, damping }], y: […] }   the printed-corner panel (web/corner_view.js)
 // }
 
 export const MAX_MODES = 6;
@@ -98,6 +100,8 @@ export const PRESETS = [
       shapers: [{ family: 'zv' }, { family: 'zvd' }, { family: 'mzv' }, { family: 'ei', vtol: 0.05 }],
       // A 10 mm move at 200 mm/s and 5000 mm/s² (units: mm).
       view: view(trapezoid(10, 200, 5000)),
+      // corner (issue 23 item 3): Klipper's ringing tower at 100 mm/s, 3000 mm/s², X and Y with measured-looking modes.
+      corner: { open: true, path: 'ringingTower', sideMm: 120, velocity: 100, accel: 3000, scv: 5, magnify: 50, x: [{ frequencyHz: 45, damping: 0.1 }, { frequencyHz: 97, damping: 0.04 }], y: [{ frequencyHz: 38, damping: 0.08 }] },
     },
   },
 ];
@@ -142,9 +146,39 @@ export function checkState(value) {
   }
   checkView(view ?? {}, fail);
   const out = clone({ modes, shapers, view: { ...DEFAULT_STATE.view, ...(view ?? {}) } });
+  if (value.corner !== undefined) out.corner = checkCorner(value.corner, fail); // corner (issue 23 item 3)
   out.modes = out.modes.map((m) => ({ frequencyHz: m.frequencyHz, damping: m.damping ?? 0 }));
   return out;
 }
+
+// corner (issue 23 item 3)
+/** The printed-corner panel's state: its shape only (the core judges the values). */
+function checkCorner(c, fail) {
+  const num = (x) => typeof x === 'number' || x === null;
+  if (!c || typeof c !== 'object' || Array.isArray(c)) fail('"corner" must be an object');
+  const out = {};
+  for (const [k, v] of Object.entries(c)) {
+    if (k === 'open') {
+      if (typeof v !== 'boolean') fail('corner.open must be true or false');
+    } else if (k === 'path') {
+      if (!['square', 'ringingTower'].includes(v)) fail('corner.path must be "square" or "ringingTower"');
+    } else if (['sideMm', 'velocity', 'accel', 'scv', 'magnify'].includes(k)) {
+      if (!num(v)) fail(`corner.${k} must be a number`);
+    } else if (k === 'x' || k === 'y') {
+      if (!Array.isArray(v) || v.length < 1 || v.length > MAX_MODES) fail(`corner.${k} must be a list of 1 to ${MAX_MODES} modes`);
+      v.forEach((m, i) => {
+        if (!m || typeof m !== 'object' || !num(m.frequencyHz) || !num(m.damping ?? 0)) fail(`corner.${k}[${i}] must be { frequencyHz: number, damping: number }`);
+      });
+      out[k] = v.map((m) => ({ frequencyHz: m.frequencyHz, damping: m.damping ?? 0 }));
+      continue;
+    } else {
+      fail(`corner.${k} is not a setting of the printed corner`);
+    }
+    out[k] = v;
+  }
+  return out;
+}
+// /corner
 
 /** Known view settings: their types. Unknown keys may hold only short plain values. */
 function checkView(view, fail) {

@@ -33,8 +33,10 @@ pub fn draw_corner<DB: DrawingBackend>(
             .chain(unshaped.into_iter().flat_map(pairs))
             .chain(tracks.iter().flat_map(|(_, t)| pairs(t)))
     };
-    let (x_lo, x_hi) = super::padded_range(all().map(|p| p.0), 0.04);
-    let (y_lo, y_hi) = super::padded_range(all().map(|p| p.1), 0.04);
+    // Clamped to ±AXIS_LIMIT: a track magnified beyond reason still gets an axis plotters can map.
+    let limit = |v: f64| v.clamp(-super::AXIS_LIMIT, super::AXIS_LIMIT);
+    let (x_lo, x_hi) = super::padded_range(all().map(|p| limit(p.0)), 0.04);
+    let (y_lo, y_hi) = super::padded_range(all().map(|p| limit(p.1)), 0.04);
     // Equal mm per pixel on both axes: widen the axis whose span per pixel is smaller.
     let (w, h) = area.dim_in_pixel();
     let (label_x, label_y) = (

@@ -82,10 +82,11 @@ pub fn render_corner(
     #[wasm_bindgen(unchecked_param_type = "HTMLCanvasElement")] canvas: JsValue,
     #[wasm_bindgen(unchecked_optional_param_type = "CornerOptions | null")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
+    // The canvas first, as every drawing export: without one (Node) the error names it.
+    let canvas = args::canvas(canvas, "canvas").map_err(js_error)?;
     let mut spec: CornerSpec = from_js_root(spec, "spec").map_err(js_error)?;
     let specs: Vec<ShaperSpec> = from_js(shapers, "shapers").map_err(js_error)?;
     crate::error::count("shapers", specs.len(), 0, MAX_SHAPERS).map_err(js_error)?;
-    let canvas = args::canvas(canvas, "canvas").map_err(js_error)?;
     let o: CornerOptions = if options.is_undefined() || options.is_null() {
         CornerOptions::default()
     } else {

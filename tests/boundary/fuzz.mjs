@@ -147,6 +147,7 @@ function exportsTable(env) {
     { name: 'identifyModes', names: ['recording', 'options'], aliases: { recording: ['signal', 'spectrum'] }, args: () => [ring(), { sampleRateHz: 1000, segmentLength: 256 }] },
     { name: 'recommendShaper', names: ['spectrum', 'modes', 'options'], args: () => [spectrum(), [mode()], { families: [{ family: 'zv' }, { family: 'ei', vtol: 0.05 }] }] },
     { name: 'firmwareConfig', names: ['request'], args: () => [{ firmware: 'klipper', axes: [{ axis: 'x', family: 'mzv', frequencyHz: 53.8 }] }] },
+    { name: 'renderCorner', names: [null, 'shapers', 'canvas', 'options'], canvas: true, args: () => [{ path: { kind: 'square', sideMm: 10 }, velocity: 100, accel: 3000, x: { modes: [{ frequencyHz: 40, damping: 0.05 }] }, y: { modes: [{ frequencyHz: 50, damping: 0.05 }] }, samplePeriodS: 0.002 }, [{ family: 'zv' }], env.canvas(), { pixelRatio: 1 }] },
     { name: 'drawSpectrum', names: ['canvas', 'spectrum', 'options'], canvas: true, args: () => [env.canvas(), spectrum(), { peaksHz: [40] }] },
     // Its data's fields are named by their keys (`frequencyHz`, `shapers[0].values`), as documented.
     { name: 'drawKlipperChart', names: ['canvas', 'data', 'options'], canvas: true, aliases: { data: ['frequencyHz', 'psdSum', 'psdX', 'psdY', 'psdZ', 'after', 'shapers'] }, args: () => { const s = spectrum(); return [env.canvas(), { frequencyHz: s.frequencyHz, psdSum: s.psd }, { maxHz: 150 }]; } },
