@@ -374,9 +374,10 @@ fn the_corner_spec_is_the_core_calls() {
     assert_eq!(r.shaped.as_ref().unwrap().print, shaped);
     assert!(r.shaper_y.is_none() && r.shaper_x.is_some());
     let drawn = r.unshaped.drawn.as_ref().unwrap();
-    for i in 0..unshaped.time.len() {
-        assert!((drawn[0][i] - unshaped.nozzle[0][i]).abs() < 1e-9);
-        assert!((drawn[1][i] - unshaped.nozzle[1][i]).abs() < 1e-9);
+    for (track, nozzle) in drawn.iter().zip(&unshaped.nozzle) {
+        for (d, n) in track.iter().zip(nozzle) {
+            assert!((d - n).abs() < 1e-9);
+        }
     }
     // ×k moves each drawn point k times as far from the path: its distance is k·|deviation|.
     let r10 = corner_for(&spec(&format!("{{{base},\"magnify\":10}}"))).unwrap();
