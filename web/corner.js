@@ -21,7 +21,7 @@ export function updateCorner() {
   const details = $('corner-panel');
   const open = !!page.state.corner?.open;
   if (details.open !== open) details.open = open;
-  if (open) openView().then((m) => m.update(), () => {});
+  if (open) openView().then((m) => m.update(page), () => {});
 }
 
 /** Wires the panel: opening it puts `corner.open` in the state (and the URL). */
@@ -31,7 +31,7 @@ export function setupCorner() {
     if (!!page.state.corner?.open === open) return;
     page.state.corner = { ...(page.state.corner ?? {}), open };
     page.changed(true);
-    if (open) openView().then((m) => m.update(), () => {});
+    if (open) openView().then((m) => m.update(page), () => {});
   });
   window.__corner = { open: openView };
 }

@@ -7,7 +7,6 @@
 // (renderCorner) per change of the panel's fields or of the compared shapers; a bad field keeps
 // the last good chart and table and says what is wrong beside the field.
 import init, { renderCorner } from '../pkg/page/corner.js';
-import { page } from './page.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -24,6 +23,9 @@ let built = false;
 let written = ''; // the corner state the fields show
 let lastKey = ''; // what the chart and table were last drawn from
 let last = null; // { spec, shapers, labels, frame }: the last good frame (for the tests)
+// The page's shared object (web/page.js) as main.js's bundle has it: this bundle is separate, so
+// it is handed over (update) rather than imported (an import would be a second copy).
+let page = null;
 
 function el(tag, props = {}, ...children) {
   const node = document.createElement(tag);
@@ -45,11 +47,11 @@ function numberField(id, label, field, unit) {
 
 function axisFields(axis) {
   const A = axis.toUpperCase();
-  return el('fieldset', { class: 'corner-axis' }, el('legend', {}, `${A} axis modes`),
+  return el('fieldset', { class: 'corner-axis corner-fields' }, el('legend', {}, `${A} axis modes`),
     numberField(`corner-${axis}-f0`, 'mode 1', `${axis}.modes[0].frequencyHz`, 'Hz'),
-    numberField(`corner-${axis}-z0`, 'ζ', `${axis}.modes[0].damping`),
+    numberField(`corner-${axis}-z0`, 'damping ζ', `${axis}.modes[0].damping`),
     numberField(`corner-${axis}-f1`, 'mode 2 (blank: none)', `${axis}.modes[1].frequencyHz`, 'Hz'),
-    numberField(`corner-${axis}-z1`, 'ζ', `${axis}.modes[1].damping`));
+    numberField(`corner-${axis}-z1`, 'damping ζ', `${axis}.modes[1].damping`));
 }
 
 function build() {
@@ -148,13 +150,17 @@ function showTable(frame) {
   $('corner-table').tBodies[0].replaceChildren(...rows);
 }
 
+let errorShown = false;
 function clearErrors() {
+  if (!errorShown) return;
+  errorShown = false;
   for (const s of $('corner-body').querySelectorAll('.field-error')) s.textContent = '';
   for (const i of $('corner-body').querySelectorAll('[aria-invalid]')) i.removeAttribute('aria-invalid');
   $('corner-error').textContent = '';
 }
 
 function showError(e) {
+  errorShown = true;
   const field = e?.field;
   const input = field ? $('corner-body').querySelector(`[data-corner-field="${CSS.escape(field)}"]`) : null;
   if (input) {
@@ -165,8 +171,12 @@ function showError(e) {
   $('corner-error').textContent = `${e?.message ?? e} The last good chart is kept.`;
 }
 
-/** Recomputes and redraws when the corner state, the compared shapers or the canvas changed. */
-export async function update() {
+/**
+ * Recomputes and redraws when the corner state, the compared shapers or the canvas changed;
+ * `shared` is the page's shared object (web/page.js: its state and `changed`).
+ */
+export async function update(shared) {
+  if (shared) page = shared;
   await ready;
   if (!built) build();
   const c = cornerState(page.state);
@@ -181,10 +191,10 @@ export async function update() {
   const h = Math.max(1, Math.round(canvas.clientHeight * ratio));
   const shapers = page.state.shapers.map((s) => ({ ...s }));
   const key = JSON.stringify({ c, shapers, w, h, ratio });
-  if (key === lastKey) return;
+  clearErrors();
+  if (key === lastKey) return; // back to what is drawn (a bad value undone): nothing to redo
   const spec = cornerSpec(c);
   const labels = shapers.map((s, i) => `${i + 1}. ${s.family}`);
-  clearErrors();
   try {
     if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
     const frame = renderCorner(spec, shapers, canvas, { pixelRatio: ratio, labels });

@@ -74,7 +74,8 @@ test('the printer preset shows the corner; its numbers are the JS API\'s; the UR
   const info = await canvasInfo(page, 'corner-chart');
   assert.ok(info.ink > 5000, `ink ${info.ink}`);
   assert.ok(await pixelsOf(page, [110, 110, 110]) > 300, 'the unshaped track (grey) is drawn');
-  assert.ok(await pixelsOf(page, [0, 114, 178]) > 300, 'the first shaper\'s track (blue) is drawn');
+  // The shaped tracks nearly coincide on the walls: the last drawn (4. ei, pink) shows most.
+  assert.ok(await pixelsOf(page, [204, 121, 167]) > 300, 'the shaped tracks are drawn (the last one, pink, on top)');
   await page.$eval('#corner', (s) => s.scrollIntoView());
   await page.locator('#corner').screenshot({ path: `${SCREENSHOTS}corner-printer-1280x800.png` });
   const hash = await page.evaluate(() => location.hash);
