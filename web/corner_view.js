@@ -133,7 +133,8 @@ export function cornerSpec(c) {
   return spec;
 }
 
-const um = (mm) => (Number.isFinite(mm) ? String(Number((mm * 1000).toPrecision(3))) : '—');
+/** mm as µm, 3 digits; rounding-level values (below 10⁻⁶ µm, an exact shaper's) as ≈ 0. */
+const um = (mm) => (!Number.isFinite(mm) ? '—' : Math.abs(mm) < 1e-9 ? '≈ 0' : String(Number((mm * 1000).toPrecision(3))));
 export { um as formatMicrons };
 
 function showTable(frame) {

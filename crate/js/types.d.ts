@@ -476,6 +476,34 @@ export interface CornerResult {
   shaperY: Shaper | null;
 }
 
+/** renderCorner's options. */
+export interface CornerOptions {
+  pixelRatio?: number | null;
+  /** A label per shaper (default: the family's name). */
+  labels?: string[] | null;
+}
+
+export interface CornerPrintNumbers {
+  label: string;
+  corners: CornerRinging[];
+  /** Largest peak deviation over the corners (mm). */
+  peakDeviation: number;
+  /** Largest ringing over the corners (mm). */
+  ringing: number;
+}
+
+/** renderCorner's result: the numbers of the prints it drew. */
+export interface CornerFrame {
+  duration: number;
+  samplePeriodS: number;
+  /** The path speed at each corner (mm/s). */
+  junctionSpeeds: number[];
+  unshaped: CornerPrintNumbers;
+  shapers: CornerPrintNumbers[];
+  /** Shapers that could not be designed: why. */
+  leftOut: { label: string; index: number; field: string | null; message: string }[];
+}
+
 // ---------------------------------------------------------------------------------------------
 // The playground frame
 

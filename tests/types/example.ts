@@ -20,6 +20,7 @@ import init, {
   simulate,
   spectrum,
   simulateCorner,
+  renderCorner,
   renderPlayground,
   parseRecording,
   RecordingParser,
@@ -135,6 +136,13 @@ export async function main(canvas: HTMLCanvasElement): Promise<void> {
   const ringing: number | undefined = print.shaped?.corners[0].ringing;
   const drawn: [number[], number[]] | null = print.unshaped.drawn;
   console.log(ringing, drawn, print.segments[1].vStart, print.shaperX?.duration);
+  const cornerFrame = renderCorner(
+    { path: { kind: "square", sideMm: 40 }, velocity: 150, accel: 5000, x: { modes: [mode] }, y: { modes: [mode] } },
+    [{ family: "zv" }, { family: "ei", vtol: 0.05 }],
+    canvas,
+    { pixelRatio: 2, labels: ["ZV", "EI"] },
+  );
+  console.log(cornerFrame.shapers[0].ringing, cornerFrame.leftOut.length, cornerFrame.junctionSpeeds[0]);
 
   // The playground frame.
   const frame = renderPlayground(
