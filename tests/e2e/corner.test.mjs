@@ -67,7 +67,7 @@ test('the printer preset shows the corner; its numbers are the JS API\'s; the UR
   for (const cells of Object.values(shown)) assert.equal(cells.length, 2 + 2 * 5);
   assert.deepEqual(shown, await fromApi(page));
   // Every shaper leaves less ringing than the unshaped print on the long walls (corners 2 and 3).
-  const ringing = (cells, k) => Number(cells[2 + 2 * k + 1]);
+  const ringing = (cells, k) => (cells[2 + 2 * k + 1] === '≈ 0' ? 0 : Number(cells[2 + 2 * k + 1]));
   for (const name of ['1. zv', '2. zvd', '3. mzv', '4. ei']) {
     for (const k of [1, 2]) assert.ok(ringing(shown[name], k) < ringing(shown.unshaped, k), `${name} corner ${k + 1}: ${ringing(shown[name], k)} vs ${ringing(shown.unshaped, k)}`);
   }
