@@ -50,7 +50,12 @@ const state = {
 // a generic controller (1 ms, 64 amplitude steps), and the printer preset (48 Hz: ZV on
 // FT_MOTION, MZV and EI on Klipper, ZVD ideal). REALISE=only runs just these, REALISE=0 none.
 const REALISED = { firmware: 'generic', periodS: 0.001, amplitudeSteps: 64 };
-const CASES = [[3, 4, 'mode'], [3, 4, 'mismatch'], [6, 4, 'mode'], [6, 4, 'mismatch'], [6, 3, 'mode'], [6, 3, 'mismatch'], [3, 1, 'mode'], [3, 1, 'mismatch'],
+// CORNER=1: the printed-corner panel open (issue 23 item 3; the printer preset's ringing tower),
+// and a third kind of edit, the corner's velocity (the corner view recomputed and redrawn).
+if (process.env.CORNER) {
+  state.corner = { open: true, path: 'ringingTower', sideMm: 120, velocity: 100, accel: 3000, scv: 5, magnify: 50, x: [{ frequencyHz: 45, damping: 0.1 }, { frequencyHz: 97, damping: 0.04 }], y: [{ frequencyHz: 38, damping: 0.08 }] };
+}
+const CASES = [[3, 4, 'mode'], [3, 4, 'mismatch'], ...(process.env.CORNER ? [[3, 4, 'corner'], [3, 1, 'corner']] : []), [6, 4, 'mode'], [6, 4, 'mismatch'], [6, 3, 'mode'], [6, 3, 'mismatch'], [3, 1, 'mode'], [3, 1, 'mismatch'],
   [3, 4, 'mode', 'realised'], [3, 4, 'mismatch', 'realised'], [1, 4, 'mode', 'printer'], [1, 4, 'mismatch', 'printer']]
   .filter(([m, n]) => (!process.env.SHAPERS || Number(process.env.SHAPERS) === n) && (!process.env.MODES || Number(process.env.MODES) === m))
   .filter(([, , , view]) => (process.env.REALISE === 'only' ? view : process.env.REALISE === '0' ? !view : true));
@@ -200,6 +205,16 @@ async function timed(p, runs, edit, modes, f0 = 1.2) {
     for (let i = 0; i < 10; i++) { await frame(); pg.update(); } // warm up
     for (let i = 0; i < n; i++) {
       await frame();
+      if (what === 'corner') {
+        // The corner view works after the playground's update (a promise): timed to its end.
+        const view = await window.__corner.open();
+        const t0 = performance.now();
+        pg.state.corner.velocity = 100 + (i % 10);
+        pg.update();
+        await view.update();
+        out.push(performance.now() - t0);
+        continue;
+      }
       if (what === 'mode') pg.state.modes[0].frequencyHz = f0 + (i % 10) * 0.01;
       else pg.state.view.mismatch = 0.8 + (i % 40) * 0.01;
       out.push(pg.update());

@@ -375,6 +375,42 @@ fn signed_distance(s: &Segment, p: [f64; 2]) -> f64 {
     off[0].hypot(off[1]).copysign(cross)
 }
 
+/// The point of the path nearest to `p` (the foot on the nearest segment).
+fn nearest_foot(segments: &[Segment], p: [f64; 2]) -> [f64; 2] {
+    let mut best = (f64::INFINITY, p);
+    for s in segments {
+        let rel = [p[0] - s.start[0], p[1] - s.start[1]];
+        let along = (rel[0] * s.direction[0] + rel[1] * s.direction[1]).clamp(0.0, s.length);
+        let foot = [
+            s.start[0] + along * s.direction[0],
+            s.start[1] + along * s.direction[1],
+        ];
+        let d = (p[0] - foot[0]).hypot(p[1] - foot[1]);
+        if d < best.0 {
+            best = (d, foot);
+        }
+    }
+    best.1
+}
+
+impl Print {
+    /// The nozzle's track as a print would show it with the deviation magnified: each sample's
+    /// nearest point on the path plus `factor` times the nozzle's offset from it (mm; X, Y).
+    /// `factor` 1 is the nozzle itself.
+    pub fn magnified(&self, plan: &Plan, factor: f64) -> Result<[Vec<f64>; 2]> {
+        finite("magnify", factor)?;
+        let n = self.time.len();
+        let (mut xs, mut ys) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for i in 0..n {
+            let p = [self.nozzle[0][i], self.nozzle[1][i]];
+            let foot = nearest_foot(&plan.segments, p);
+            xs.push(foot[0] + factor * (p[0] - foot[0]));
+            ys.push(foot[1] + factor * (p[1] - foot[1]));
+        }
+        Ok([xs, ys])
+    }
+}
+
 fn nearest_signed_distance(segments: &[Segment], p: [f64; 2]) -> f64 {
     segments
         .iter()
@@ -417,12 +453,43 @@ fn ringing_after(wall: &Segment, time: &[f64], nozzle: &[Vec<f64>; 2], lag: f64)
 
 /// A square of side `side` (mm) from the origin, counter-clockwise, back to the start.
 pub fn square(side: f64) -> Result<Vec<[f64; 2]>> {
-    positive("side", side)?;
+    positive("sideMm", side)?;
     Ok(vec![
         [0.0, 0.0],
         [side, 0.0],
         [side, side],
         [0.0, side],
+        [0.0, 0.0],
+    ])
+}
+
+/// Klipper's ringing tower's outline (docs/Resonance_Compensation.md prints
+/// docs/prints/ringing_tower.stl, "the ringing test model"): an L of two walls, each `side` mm
+/// long (120 in the model) and `thickness` mm thick (8), standing on the X and Y axes, so that
+/// each wall rings with one axis. A slicer's outer perimeter of it is this closed polygon:
+/// from the origin along +X, around the end of the X wall, back along the inner face to the
+/// inner (concave) corner, up the inner face of the Y wall, around its end and down its outer
+/// face to the origin — five convex 90° corners and one concave. Read off the model's vertices
+/// at z = 0 (its footprint spans 0…120 mm in X and Y; the inner faces are at x = 8 and
+/// y = 8); the model's notches on the inner faces, its X and Y marks and its 0.15 mm smoothing
+/// gap, there to make ringing and smoothing visible on a print, are left out.
+pub fn ringing_tower(side: f64, thickness: f64) -> Result<Vec<[f64; 2]>> {
+    positive("sideMm", side)?;
+    positive("thicknessMm", thickness)?;
+    if thickness >= side {
+        return Err(Error::invalid(
+            "thicknessMm",
+            format!("must be less than sideMm ({side} mm), got {thickness}"),
+        ));
+    }
+    let (l, w) = (side, thickness);
+    Ok(vec![
+        [0.0, 0.0],
+        [l, 0.0],
+        [l, w],
+        [w, w],
+        [w, l],
+        [0.0, l],
         [0.0, 0.0],
     ])
 }

@@ -11,7 +11,7 @@ use crate::design::{design_for, ShaperSpec};
 use crate::error::{finite, positive, Error, Result};
 use crate::metrics::{metrics, mode_residual_percent, Metrics};
 use crate::mode::{Mode, ModeSpec};
-use crate::plant::{Plant, PlantSpec};
+use crate::plant::{Plant, PlantModeSpec, PlantSpec};
 use crate::shaper::{Impulse, Shaper, ShaperData};
 use crate::simulate::{sample_count, simulate, Trajectory, DEFAULT_SAMPLES};
 use crate::spectrum::{command_spectrum, SpectrumOptions, SpectrumSignal};
@@ -328,5 +328,266 @@ pub fn spectrum_for(spec: &SpectrumSpec) -> Result<SpectrumResult> {
         magnitude,
         unshaped: unshaped.magnitude,
         modes_hz,
+    })
+}
+
+crate::tagged::tagged_enum! {
+    tag = "kind", rename_all = "camelCase", mirror = path_spec_serde;
+    /// A toolpath as written in a corner spec (`{ kind, … }`; mm).
+    #[derive(Debug, Clone, PartialEq)]
+    pub enum PathSpec {
+        /// `{ kind: "square", sideMm }`: a square from the origin, counter-clockwise
+        /// ([`crate::corner::square`]).
+        #[serde(rename_all = "camelCase")]
+        Square {
+            /// Side (mm, > 0).
+            side_mm: f64,
+        },
+        /// `{ kind: "ringingTower", sideMm?, thicknessMm? }`: the outline of Klipper's ringing
+        /// test model, an L of two walls (default 120 mm long, 8 mm thick;
+        /// [`crate::corner::ringing_tower`]).
+        #[serde(rename_all = "camelCase")]
+        RingingTower {
+            /// Length of each wall (mm, default 120).
+            #[serde(default = "tower_side")]
+            side_mm: f64,
+            /// Thickness of each wall (mm, default 8, less than `sideMm`).
+            #[serde(default = "tower_thickness")]
+            thickness_mm: f64,
+        },
+    }
+}
+
+fn tower_side() -> f64 {
+    120.0
+}
+
+fn tower_thickness() -> f64 {
+    8.0
+}
+
+fn klipper_scv() -> f64 {
+    5.0
+}
+
+impl PathSpec {
+    /// The path's points (mm); errors name `sideMm`, `thicknessMm`.
+    pub fn points(&self) -> Result<Vec<[f64; 2]>> {
+        match *self {
+            PathSpec::Square { side_mm } => crate::corner::square(side_mm),
+            PathSpec::RingingTower {
+                side_mm,
+                thickness_mm,
+            } => crate::corner::ringing_tower(side_mm, thickness_mm),
+        }
+    }
+}
+
+/// One axis of a corner spec: its modes and, optionally, its shaper.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct CornerAxisSpec {
+    /// The axis's modes (`[{ frequencyHz, damping?, participation? }]`).
+    pub modes: Vec<PlantModeSpec>,
+    /// The shaper to design (`{ family, modes?, … }`; default modes: the axis's); or give
+    /// `impulses`, or neither (the axis runs unshaped in the shaped print too).
+    #[serde(default)]
+    pub shaper: Option<ShaperRequest>,
+    /// An explicit shaper (`[{ time, amplitude }]`).
+    #[serde(default)]
+    pub impulses: Option<Vec<Impulse>>,
+}
+
+/// Everything [`corner_for`] needs, as written in JSON (mm, s).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct CornerSpec {
+    /// The toolpath.
+    pub path: PathSpec,
+    /// Top speed along the path (mm/s).
+    pub velocity: f64,
+    /// Acceleration along the path (mm/s²).
+    pub accel: f64,
+    /// Klipper's `square_corner_velocity` (mm/s, default 5 as in Klipper).
+    #[serde(default = "klipper_scv")]
+    pub square_corner_velocity: f64,
+    /// The X axis.
+    pub x: CornerAxisSpec,
+    /// The Y axis.
+    pub y: CornerAxisSpec,
+    /// Sample period (s); default: a 25th of the fastest mode's period, at most 1 ms, made
+    /// longer if the print would need more than [`CORNER_SAMPLES`] samples.
+    #[serde(default)]
+    pub sample_period_s: Option<f64>,
+    /// Time simulated after the path ends (s, default 0.05).
+    #[serde(default)]
+    pub settle_s: Option<f64>,
+    /// When given, each print also carries its track with the deviation magnified this many
+    /// times (`drawn`, [`crate::corner::Print::magnified`]).
+    #[serde(default)]
+    pub magnify: Option<f64>,
+}
+
+/// Most samples the default sample period of a corner spec gives.
+pub const CORNER_SAMPLES: usize = 20_000;
+
+/// One simulated print, as [`corner_for`] returns it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct PrintResult {
+    /// Times, nozzle, deviation and the corners' numbers.
+    #[serde(flatten)]
+    pub print: crate::corner::Print,
+    /// The track with the deviation magnified `magnify` times (mm; X, Y), when asked for.
+    pub drawn: Option<[Vec<f64>; 2]>,
+}
+
+/// The result of [`corner_for`].
+#[derive(Debug, Clone, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct CornerResult {
+    /// The planned segments (junction speeds, trapezoid times).
+    pub segments: Vec<crate::corner::Segment>,
+    /// Time the path ends (s).
+    pub duration: f64,
+    /// Sample period used (s).
+    pub sample_period_s: f64,
+    /// The print with both axes unshaped.
+    pub unshaped: PrintResult,
+    /// The print with each axis shaped by its shaper (when either axis has one).
+    pub shaped: Option<PrintResult>,
+    /// X's shaper.
+    pub shaper_x: Option<ShaperData>,
+    /// Y's shaper.
+    pub shaper_y: Option<ShaperData>,
+}
+
+/// A corner spec made ready to print: the plan, the axes' plants and shapers, the sampling.
+pub struct CornerSetup {
+    /// The planned path.
+    pub plan: crate::corner::Plan,
+    /// X's and Y's plants.
+    pub plants: [crate::plant::ModalPlant; 2],
+    /// X's and Y's shapers from the spec.
+    pub shapers: [Option<Shaper>; 2],
+    /// Sample period (s).
+    pub sample_period: f64,
+    /// Time simulated after the path ends (s).
+    pub settle: f64,
+    /// The magnification of the drawn track, if asked for.
+    pub magnify: Option<f64>,
+}
+
+impl CornerSetup {
+    /// Validates and plans `spec` (errors named from its root) and designs its shapers.
+    pub fn new(spec: &CornerSpec) -> Result<Self> {
+        use crate::corner::{plan, MotionLimits};
+        use crate::plant::ModalPlant;
+        let points = spec.path.points().map_err(|e| e.within("path"))?;
+        let limits = MotionLimits {
+            velocity: spec.velocity,
+            accel: spec.accel,
+            square_corner_velocity: spec.square_corner_velocity,
+        };
+        let planned = plan(&points, &limits)?;
+        let axis = |a: &CornerAxisSpec, name: &str| -> Result<(ModalPlant, Option<Shaper>)> {
+            let plant = ModalPlant::from_spec(&a.modes).map_err(|e| e.within(name))?;
+            let shaper = resolve_shaper(&a.shaper, &a.impulses, || Ok(plant.modes().to_vec()))
+                .map_err(|e| e.within(name))?;
+            Ok((plant, shaper))
+        };
+        let (px, sx) = axis(&spec.x, "x")?;
+        let (py, sy) = axis(&spec.y, "y")?;
+        let settle = spec.settle_s.unwrap_or(0.05);
+        finite("settleS", settle)?;
+        if settle < 0.0 {
+            return Err(Error::invalid(
+                "settleS",
+                format!("must be ≥ 0 s, got {settle}"),
+            ));
+        }
+        let total = planned.duration() + settle;
+        let sample_period = match spec.sample_period_s {
+            Some(t) => positive("samplePeriodS", t)?,
+            None => {
+                let fastest = px
+                    .modes()
+                    .iter()
+                    .chain(py.modes())
+                    .map(Mode::frequency_hz)
+                    .fold(0.0_f64, f64::max);
+                (1.0 / (25.0 * fastest))
+                    .min(1e-3)
+                    .max(total / (CORNER_SAMPLES - 1) as f64)
+            }
+        };
+        sample_count(sample_period, total).map_err(|e| match e {
+            Error::TooLarge { value, limit, .. } => Error::TooLarge {
+                field: "samplePeriodS".into(),
+                value,
+                limit,
+            },
+            other => other,
+        })?;
+        let magnify = spec.magnify.map(|m| positive("magnify", m)).transpose()?;
+        Ok(CornerSetup {
+            plan: planned,
+            plants: [px, py],
+            shapers: [sx, sy],
+            sample_period,
+            settle,
+            magnify,
+        })
+    }
+
+    /// The print with X shaped by `x` and Y by `y` (`None`: unshaped).
+    pub fn print(&self, x: Option<&Shaper>, y: Option<&Shaper>) -> Result<PrintResult> {
+        use crate::corner::{corner, Axis};
+        let axes = [
+            Axis {
+                plant: &self.plants[0],
+                shaper: x,
+            },
+            Axis {
+                plant: &self.plants[1],
+                shaper: y,
+            },
+        ];
+        let print = corner(&self.plan, axes, self.sample_period, self.settle)?;
+        let drawn = self
+            .magnify
+            .map(|m| print.magnified(&self.plan, m))
+            .transpose()?;
+        Ok(PrintResult { print, drawn })
+    }
+
+    /// The shaper `spec` designed for X's modes and for Y's (errors named `x.…`, `y.…`).
+    pub fn design_per_axis(&self, spec: &ShaperSpec) -> Result<[Shaper; 2]> {
+        let x = design_for(spec, self.plants[0].modes()).map_err(|e| e.within("x"))?;
+        let y = design_for(spec, self.plants[1].modes()).map_err(|e| e.within("y"))?;
+        Ok([x, y])
+    }
+}
+
+/// Plans a corner spec's path, designs each axis's shaper, and prints the path unshaped and
+/// shaped ([`crate::corner`]). Errors name the field from the spec's root (`path.sideMm`,
+/// `x.modes[0].frequencyHz`, `y.shaper.family`, `squareCornerVelocity`).
+pub fn corner_for(spec: &CornerSpec) -> Result<CornerResult> {
+    let setup = CornerSetup::new(spec)?;
+    let [sx, sy] = &setup.shapers;
+    let unshaped = setup.print(None, None)?;
+    let shaped = if sx.is_some() || sy.is_some() {
+        Some(setup.print(sx.as_ref(), sy.as_ref())?)
+    } else {
+        None
+    };
+    Ok(CornerResult {
+        duration: setup.plan.duration(),
+        sample_period_s: setup.sample_period,
+        unshaped,
+        shaped,
+        shaper_x: sx.as_ref().map(Shaper::to_data),
+        shaper_y: sy.as_ref().map(Shaper::to_data),
+        segments: setup.plan.segments,
     })
 }

@@ -28,7 +28,7 @@ if [ "${STABLE:-0}" != 1 ] && sysroot=$(rustup run "$nightly" rustc --print sysr
   use_nightly=1
 fi
 
-# Four modules from one crate, each with the exports of some Cargo features (Cargo.toml):
+# Five modules from one crate, each with the exports of some Cargo features (Cargo.toml):
 #   pkg/input_shaping.js          the whole JavaScript API (docs/js-api.md), for programs of your own;
 #   pkg/page/playground.js        what the page calls (js-playground) without the optimisation
 #                                 solver: the solved families (si, direct, bounded sampled)
@@ -37,7 +37,9 @@ fi
 #   pkg/page/designer.js          `design` and the solver (js-designer + solver), for the page's
 #                                 design worker, fetched when a solved family is first shown;
 #   pkg/page/recording.js         what its measured-data worker calls (js-recording), fetched
-#                                 only when a recording is opened.
+#                                 only when a recording is opened;
+#   pkg/page/corner.js            the printed-corner view's `renderCorner` (js-corner), fetched
+#                                 when that view is first opened (opt-level 2: it runs per edit).
 # The linker keeps only the code an export reaches, so the page's modules are smaller than the
 # whole API's (docs/page-performance.md, *Shipped size*). The same sources, the same results.
 #
@@ -162,13 +164,14 @@ if [ "$what" != --library ]; then
   module js-playground pkg/page playground 2 2
   module js-designer,solver pkg/page designer z z
   module js-recording pkg/page recording 2 2
+  module js-corner pkg/page corner 2 2
 fi
 for pid in "${pids[@]+"${pids[@]}"}"; do wait "$pid"; done
 if [ "$what" = --check ]; then exit $((stale > 0)); fi
 if [ "$what" = --library ]; then modules=(pkg/input_shaping); bundles=(); else
   bash scripts/bundle.sh
-  modules=(pkg/input_shaping pkg/page/playground pkg/page/designer pkg/page/recording)
-  bundles=(pkg/page/main.js pkg/page/measure_worker.js pkg/page/design_worker.js)
+  modules=(pkg/input_shaping pkg/page/playground pkg/page/designer pkg/page/recording pkg/page/corner)
+  bundles=(pkg/page/main.js pkg/page/measure_worker.js pkg/page/design_worker.js pkg/page/corner_view.js)
 fi
 
 gz() { gzip -9 -c "$1" | wc -c; }

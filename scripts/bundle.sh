@@ -6,6 +6,8 @@
 #   measure_view.js    web/measure_view.js (the measured-data view) with the recording module's
 #                      glue (it draws the Klipper-style charts); imported by main.js when the
 #                      measured-data path is first opened;
+#   corner_view.js     web/corner_view.js (the printed-corner view) with the corner module's
+#                      glue; imported by main.js when that view is first opened;
 #   measure_worker.js  web/measure_worker.js with the recording module's glue and the
 #                      playground module's (it ranks shapers with the page's module, which
 #                      main.js hands it compiled); started when the first recording is opened;
@@ -19,4 +21,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 common=(--bundle --minify --format=esm --target=es2020 --sourcemap --outdir=pkg/page --log-level=warning)
-node_modules/.bin/esbuild web/main.js web/measure_view.js web/measure_worker.js web/design_worker.js web/realise_view.js "${common[@]}"
+node_modules/.bin/esbuild web/main.js web/measure_view.js web/corner_view.js web/measure_worker.js web/design_worker.js web/realise_view.js "${common[@]}"

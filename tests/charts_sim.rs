@@ -373,3 +373,147 @@ fn shaped_spectrum_is_the_product_of_shaper_and_command_spectra() {
         );
     }
 }
+
+/// Distance from `p` to the polyline `path`, and the fraction along the nearest segment.
+fn to_polyline(path: &[(f64, f64)], p: (f64, f64)) -> (f64, f64) {
+    let mut best = (f64::INFINITY, 0.0);
+    for w in path.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let d = (b.0 - a.0, b.1 - a.1);
+        let len2 = d.0 * d.0 + d.1 * d.1;
+        let t = (((p.0 - a.0) * d.0 + (p.1 - a.1) * d.1) / len2).clamp(0.0, 1.0);
+        let dist = (p.0 - a.0 - t * d.0).hypot(p.1 - a.1 - t * d.1);
+        if dist < best.0 {
+            best = (dist, t);
+        }
+    }
+    best
+}
+
+/// The printed-corner chart: the path with equal scales on X and Y, the unshaped track as far
+/// from it (in pixels) as the magnified track is in mm, and the track shaped by exact ZV shapers
+/// straight in the middle of every wall, where the unshaped one still rings.
+#[test]
+fn corner_chart_draws_the_magnified_walls_on_equal_scales() {
+    use input_shaping::chart::corner::PATH_COLOR;
+    use input_shaping::chart::draw_corner;
+    use input_shaping::corner::{corner, plan, square, Axis, MotionLimits};
+    let (mx, my) = (
+        Mode::new(40.0, 0.02).unwrap(),
+        Mode::new(50.0, 0.02).unwrap(),
+    );
+    let (px, py) = (
+        ModalPlant::new(vec![mx], vec![1.0]).unwrap(),
+        ModalPlant::new(vec![my], vec![1.0]).unwrap(),
+    );
+    let (sx, sy) = (zv(&mx).unwrap(), zv(&my).unwrap());
+    let points = square(20.0).unwrap();
+    let limits = MotionLimits {
+        velocity: 100.0,
+        accel: 3000.0,
+        square_corner_velocity: 5.0,
+    };
+    let p = plan(&points, &limits).unwrap();
+    let print = |x, y| {
+        corner(
+            &p,
+            [
+                Axis {
+                    plant: &px,
+                    shaper: x,
+                },
+                Axis {
+                    plant: &py,
+                    shaper: y,
+                },
+            ],
+            2e-4,
+            0.02,
+        )
+        .unwrap()
+    };
+    let magnify = 20.0;
+    let unshaped = print(None, None).magnified(&p, magnify).unwrap();
+    let shaped = print(Some(&sx), Some(&sy)).magnified(&p, magnify).unwrap();
+    let out = svg(|a| {
+        draw_corner(
+            a,
+            &points,
+            Some(&unshaped),
+            &[("ZV", &shaped)],
+            magnify,
+            &ChartStyle::default(),
+        )
+        .unwrap()
+    });
+    assert!(
+        texts(&out).iter().any(|t| t.contains("×20")),
+        "{:?}",
+        texts(&out)
+    );
+    let longest = |c: RGBColor| polylines(&out, c).into_iter().max_by_key(Vec::len).unwrap();
+    let path = longest(PATH_COLOR);
+    assert_eq!(path.len(), 5);
+    let along_x = (path[1].0 - path[0].0).abs();
+    let along_y = (path[2].1 - path[1].1).abs();
+    assert!(
+        along_x > 200.0 && (along_x - along_y).abs() <= 1.0,
+        "{along_x} vs {along_y}"
+    );
+    let scale = along_x / 20.0; // px per mm
+                                // The farthest the magnified track gets from the path, in mm, against the drawing.
+    let farthest_mm = (0..unshaped[0].len())
+        .map(|i| {
+            let q = (unshaped[0][i], unshaped[1][i]);
+            let pts: Vec<(f64, f64)> = points.iter().map(|p| (p[0], p[1])).collect();
+            to_polyline(&pts, q).0
+        })
+        .fold(0.0, f64::max);
+    let grey = longest(UNSHAPED_COLOR);
+    let middle = |track: &[(f64, f64)]| {
+        track
+            .iter()
+            .map(|&q| to_polyline(&path, q))
+            .filter(|(_, t)| (0.4..=0.6).contains(t))
+            .map(|(d, _)| d)
+            .fold(0.0, f64::max)
+    };
+    let farthest_px = grey
+        .iter()
+        .map(|&q| to_polyline(&path, q).0)
+        .fold(0.0, f64::max);
+    assert!(farthest_px > 5.0, "{farthest_px}");
+    assert!(
+        (farthest_px - scale * farthest_mm).abs() < 1.5,
+        "{farthest_px} px vs {} px",
+        scale * farthest_mm
+    );
+    let (ringing, straight) = (middle(&grey), middle(&longest(SERIES_COLORS[0])));
+    assert!(
+        ringing > 3.0 && straight < 0.5,
+        "unshaped {ringing} px, ZV {straight} px"
+    );
+}
+
+/// A track magnified beyond reason (or not finite) still draws: no panic, axes within reach.
+#[test]
+fn corner_chart_survives_absurd_tracks() {
+    use input_shaping::chart::draw_corner;
+    let points = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]];
+    let wild = [
+        vec![0.0, 1e308, -1e308, f64::NAN, f64::INFINITY],
+        vec![0.0, -1e308, 1e308, 1.0, 2.0],
+    ];
+    let out = svg(|a| {
+        draw_corner(
+            a,
+            &points,
+            Some(&wild),
+            &[("x", &wild)],
+            1e300,
+            &ChartStyle::default(),
+        )
+        .unwrap()
+    });
+    assert!(out.contains("<polyline"));
+}

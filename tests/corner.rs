@@ -3,7 +3,7 @@
 //! the shaped ringing after a corner against V times the unshaped one.
 
 use input_shaping::command::{trapezoid, Command};
-use input_shaping::corner::{corner, plan, square, Axis, MotionLimits};
+use input_shaping::corner::{corner, plan, ringing_tower, square, Axis, MotionLimits};
 use input_shaping::design::zero_vibration::{zv, zvd};
 use input_shaping::plant::{ModalPlant, Plant};
 use input_shaping::simulate::simulate;
@@ -246,5 +246,212 @@ fn bad_paths_and_limits_are_named() {
         field(plan(&[[0.0, 0.0], [1.0, 0.0]], &limits(100.0, 10.0, -1.0)).unwrap_err()).as_deref(),
         Some("squareCornerVelocity")
     );
-    assert_eq!(field(square(0.0).unwrap_err()).as_deref(), Some("side"));
+    assert_eq!(field(square(0.0).unwrap_err()).as_deref(), Some("sideMm"));
+    assert_eq!(
+        field(ringing_tower(120.0, 0.0).unwrap_err()).as_deref(),
+        Some("thicknessMm")
+    );
+    assert_eq!(
+        field(ringing_tower(8.0, 8.0).unwrap_err()).as_deref(),
+        Some("thicknessMm")
+    );
+}
+
+/// Klipper's ringing tower (docs/prints/ringing_tower.stl): an L of two 120 mm walls, 8 mm
+/// thick. Its outline turns by 90° five times to the left and once to the right (the inner
+/// corner); every corner is taken at square_corner_velocity; a wall along Y shows only X's
+/// ringing and a wall along X only Y's ("ringing of X axis shows *along* Y axis",
+/// docs/Resonance_Compensation.md); and the ringing on the long inner Y wall repeats every V/f
+/// mm, the relation Klipper's guide measures the frequency by ("ringing frequency = V·N/D").
+#[test]
+fn the_ringing_tower_rings_each_wall_with_one_axis() {
+    let pts = ringing_tower(120.0, 8.0).unwrap();
+    assert_eq!(pts.first(), pts.last());
+    let p = plan(&pts, &limits(100.0, 3000.0, 5.0)).unwrap();
+    assert_eq!(p.segments.len(), 6);
+    let turns: Vec<f64> = p
+        .segments
+        .windows(2)
+        .map(|w| {
+            let (a, b) = (w[0].direction, w[1].direction);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .collect();
+    assert_eq!(turns, [1.0, 1.0, -1.0, 1.0, 1.0]);
+    for w in p.segments.windows(2) {
+        assert!((w[0].v_end - 5.0).abs() < 1e-9, "{}", w[0].v_end);
+    }
+    let (f, zeta) = (40.0, 0.01);
+    let ringing = plant(f, zeta);
+    let rigid = ModalPlant::new(vec![Mode::new(f, zeta).unwrap()], vec![0.0]).unwrap();
+    let run = |x: &ModalPlant, y: &ModalPlant| {
+        corner(
+            &p,
+            [
+                Axis {
+                    plant: x,
+                    shaper: None,
+                },
+                Axis {
+                    plant: y,
+                    shaper: None,
+                },
+            ],
+            1e-4,
+            0.0,
+        )
+        .unwrap()
+    };
+    // Walls after corners 0..5 run along +Y, −X, +Y, −X, −Y.
+    let along_y = [true, false, true, false, true];
+    for (x, y, x_rings) in [(&ringing, &rigid, true), (&rigid, &ringing, false)] {
+        let print = run(x, y);
+        for (c, &wall_along_y) in print.corners.iter().zip(&along_y) {
+            if wall_along_y == x_rings {
+                assert!(c.peak_deviation > 1e-3, "{c:?}");
+            } else {
+                assert!(c.peak_deviation < 1e-9, "{c:?}");
+            }
+        }
+    }
+    // X ringing on the inner Y wall (segment 3, x = 8): spatial period V/f_d while cruising.
+    let print = run(&ringing, &rigid);
+    let wall = p.segments[3];
+    let (t0, t1) = (wall.t_start + wall.t_accel, wall.t_decel_start());
+    let mut crossings = Vec::new();
+    for i in 1..print.time.len() {
+        let (ta, tb) = (print.time[i - 1], print.time[i]);
+        if ta < t0 || tb > t1 {
+            continue;
+        }
+        let (da, db) = (print.nozzle[0][i - 1] - 8.0, print.nozzle[0][i] - 8.0);
+        if da * db < 0.0 {
+            let s = da / (da - db);
+            crossings
+                .push(print.nozzle[1][i - 1] + s * (print.nozzle[1][i] - print.nozzle[1][i - 1]));
+        }
+    }
+    assert!(crossings.len() > 20, "{}", crossings.len());
+    let half = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
+    let expected = 100.0 / (f * (1.0 - zeta * zeta).sqrt());
+    assert!(
+        (2.0 * half - expected).abs() < 1e-3 * expected,
+        "{} mm vs V/f_d = {expected} mm",
+        2.0 * half
+    );
+}
+
+/// The JSON spec (what `simulateCorner` takes): the same prints as the core calls, the shaped
+/// print only when an axis has a shaper, the magnified track through the nozzle at ×1, and each
+/// bad field named from the spec's root.
+#[test]
+fn the_corner_spec_is_the_core_calls() {
+    use input_shaping::scenario::{corner_for, CornerSpec};
+    let spec = |text: &str| -> CornerSpec { serde_json::from_str(text).unwrap() };
+    let base = r#""path":{"kind":"square","sideMm":30},"velocity":120,"accel":4000,
+        "x":{"modes":[{"frequencyHz":42,"damping":0.06}],"shaper":{"family":"zvd"}},
+        "y":{"modes":[{"frequencyHz":55,"damping":0.05}]},"samplePeriodS":0.0002"#;
+    let r = corner_for(&spec(&format!("{{{base},\"magnify\":1}}"))).unwrap();
+    let p = plan(&square(30.0).unwrap(), &limits(120.0, 4000.0, 5.0)).unwrap();
+    assert_eq!(r.segments, p.segments);
+    let (xp, yp) = (plant(42.0, 0.06), plant(55.0, 0.05));
+    let sx = zvd(&Mode::new(42.0, 0.06).unwrap()).unwrap();
+    fn axes<'a>(x: &'a ModalPlant, y: &'a ModalPlant, s: Option<&'a Shaper>) -> [Axis<'a>; 2] {
+        [
+            Axis {
+                plant: x,
+                shaper: s,
+            },
+            Axis {
+                plant: y,
+                shaper: None,
+            },
+        ]
+    }
+    let unshaped = corner(&p, axes(&xp, &yp, None), 2e-4, 0.05).unwrap();
+    let shaped = corner(&p, axes(&xp, &yp, Some(&sx)), 2e-4, 0.05).unwrap();
+    assert_eq!(r.unshaped.print, unshaped);
+    assert_eq!(r.shaped.as_ref().unwrap().print, shaped);
+    assert!(r.shaper_y.is_none() && r.shaper_x.is_some());
+    let drawn = r.unshaped.drawn.as_ref().unwrap();
+    for (track, nozzle) in drawn.iter().zip(&unshaped.nozzle) {
+        for (d, n) in track.iter().zip(nozzle) {
+            assert!((d - n).abs() < 1e-9);
+        }
+    }
+    // ×k moves each drawn point k times as far from the path: its distance is k·|deviation|.
+    let r10 = corner_for(&spec(&format!("{{{base},\"magnify\":10}}"))).unwrap();
+    let d10 = r10.unshaped.drawn.unwrap();
+    let i = unshaped
+        .deviation
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .unwrap()
+        .0;
+    let foot_offset = |k: f64, d: &[Vec<f64>; 2]| {
+        ((d[0][i] - unshaped.nozzle[0][i]).hypot(d[1][i] - unshaped.nozzle[1][i])) / (k - 1.0)
+    };
+    assert!(
+        (foot_offset(10.0, &d10) - unshaped.deviation[i].abs()).abs() < 1e-9,
+        "{} vs {}",
+        foot_offset(10.0, &d10),
+        unshaped.deviation[i]
+    );
+    assert!(r10.unshaped.print.corners.len() == 3 && r.unshaped.drawn.is_some());
+    let plain = corner_for(&spec(
+        r#"{"path":{"kind":"ringingTower"},"velocity":100,"accel":3000,
+        "x":{"modes":[{"frequencyHz":42}]},"y":{"modes":[{"frequencyHz":55}]}}"#,
+    ))
+    .unwrap();
+    assert!(plain.shaped.is_none() && plain.unshaped.drawn.is_none());
+    assert_eq!(plain.unshaped.print.corners.len(), 5);
+    assert!(plain.sample_period_s <= 1.0 / (25.0 * 55.0) + 1e-15);
+    let field = |text: &str| {
+        corner_for(&spec(text))
+            .unwrap_err()
+            .field()
+            .map(str::to_owned)
+    };
+    let axes_ok = r#""x":{"modes":[{"frequencyHz":42}]},"y":{"modes":[{"frequencyHz":55}]}"#;
+    for (bad, name) in [
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":0}},"velocity":1,"accel":1,{axes_ok}}}"#),
+            "path.sideMm",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"ringingTower","thicknessMm":130}},"velocity":1,"accel":1,{axes_ok}}}"#),
+            "path.thicknessMm",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":0,"accel":1,{axes_ok}}}"#),
+            "velocity",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":1,"accel":1,"squareCornerVelocity":-1,{axes_ok}}}"#),
+            "squareCornerVelocity",
+        ),
+        (
+            r#"{"path":{"kind":"square","sideMm":9},"velocity":1,"accel":1,"x":{"modes":[{"frequencyHz":-1}]},"y":{"modes":[{"frequencyHz":55}]}}"#.to_string(),
+            "x.modes[0].frequencyHz",
+        ),
+        (
+            r#"{"path":{"kind":"square","sideMm":9},"velocity":1,"accel":1,"x":{"modes":[{"frequencyHz":42}]},"y":{"modes":[{"frequencyHz":55}],"shaper":{"family":"ei","vtol":2}}}"#.to_string(),
+            "y.shaper.vtol",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":1,"accel":1,{axes_ok},"samplePeriodS":1e-9}}"#),
+            "samplePeriodS",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":1,"accel":1,{axes_ok},"settleS":-1}}"#),
+            "settleS",
+        ),
+        (
+            format!(r#"{{"path":{{"kind":"square","sideMm":9}},"velocity":1,"accel":1,{axes_ok},"magnify":0}}"#),
+            "magnify",
+        ),
+    ] {
+        assert_eq!(field(&bad).as_deref(), Some(name), "{bad}");
+    }
 }

@@ -325,3 +325,43 @@ fn robust_families_through_js() {
     );
     assert_eq!(field.as_deref(), Some("modes[0].damping"), "{message}");
 }
+
+/// `simulateCorner` through the JS boundary returns what `scenario::corner_for` computes in
+/// Rust, number for number, and names a bad field from the spec's root.
+#[wasm_bindgen_test]
+fn simulate_corner_is_the_rust_result() {
+    let text = r#"{"path":{"kind":"ringingTower","sideMm":40,"thicknessMm":4},
+        "velocity":100,"accel":3000,"squareCornerVelocity":5,
+        "x":{"modes":[{"frequencyHz":42,"damping":0.06}],"shaper":{"family":"mzv"}},
+        "y":{"modes":[{"frequencyHz":55,"damping":0.05}],"shaper":{"family":"zv"}},
+        "magnify":20}"#;
+    let r = wasm::simulate_corner(js(text)).unwrap();
+    let spec: input_shaping::scenario::CornerSpec = serde_json::from_str(text).unwrap();
+    let rust = input_shaping::scenario::corner_for(&spec).unwrap();
+    let expected = js(&serde_json::to_string(&rust).unwrap());
+    assert_eq!(
+        JSON::stringify(&r).unwrap(),
+        JSON::stringify(&expected).unwrap()
+    );
+    let corners: js_sys::Array = get(&get(&r, "shaped"), "corners").dyn_into().unwrap();
+    assert_eq!(corners.length(), 5);
+    for (bad, field) in [
+        (r#""path":{"kind":"square","sideMm":-1}"#, "path.sideMm"),
+        (
+            r#""path":{"kind":"ringingTower","thicknessMm":200}"#,
+            "path.thicknessMm",
+        ),
+    ] {
+        let spec = format!(
+            r#"{{{bad},"velocity":100,"accel":3000,"x":{{"modes":[{{"frequencyHz":42}}]}},"y":{{"modes":[{{"frequencyHz":55}}]}}}}"#
+        );
+        let (message, got) = error_message(wasm::simulate_corner(js(&spec)).unwrap_err());
+        assert_eq!(got.as_deref(), Some(field), "{message}");
+    }
+    let (message, got) = error_message(
+        wasm::simulate_corner(js(r#"{"path":{"kind":"square","sideMm":10},"velocity":100,"accel":3000,
+            "x":{"modes":[{"frequencyHz":-42}]},"y":{"modes":[{"frequencyHz":55}],"shaper":{"family":"zv"}}}"#))
+        .unwrap_err(),
+    );
+    assert_eq!(got.as_deref(), Some("x.modes[0].frequencyHz"), "{message}");
+}

@@ -10,6 +10,7 @@ import * as api from '../pkg/page/playground.js';
 import { DEFAULT_STATE, PRESETS, MAX_MODES, checkState, clone, toHash, fromHash } from './state.js';
 import { commandFor, parseParam } from './params.js';
 import { setupMeasure } from './measure.js';
+import { setupCorner, updateCorner } from './corner.js'; // corner (issue 23 item 3)
 import { $, el, readNumber, notice, download } from './dom.js';
 import { page } from './page.js';
 import { rebuild, commandFields, clearErrors, showError } from './editors.js';
@@ -96,6 +97,7 @@ function update() {
       if (!page.lastGood && !$('general-error').textContent) $('general-error').textContent = `Nothing can be drawn until this is fixed: ${error?.message ?? error}`;
     }
   }
+  updateCorner(); // corner (issue 23 item 3): redrawn only when its own inputs changed
   return performance.now() - t0;
 }
 
@@ -341,6 +343,7 @@ async function main() {
     drawSpectrum: (...args) => api.drawSpectrum(...args),
     acceptModes(modes) { page.state.modes = modes.slice(0, MAX_MODES); rebuild(); changed(true); },
   });
+  setupCorner(); // corner (issue 23 item 3)
   // For the benchmark script: a full update, timed.
   window.__playground = { update, get state() { return page.state; } };
 }

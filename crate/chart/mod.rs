@@ -2,6 +2,7 @@
 //! canvas (plotters-canvas), native tests into an SVG string they can assert on.
 
 pub mod command;
+pub mod corner;
 mod curves;
 pub mod damping;
 pub mod impulses;
@@ -19,6 +20,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 pub use command::draw_command;
+pub use corner::{draw_corner, CornerTrack};
 pub use damping::draw_damping_sensitivity;
 pub use impulses::draw_impulses;
 pub use klipper::{draw_klipper_chart, KlipperChart, ShaperCurve};

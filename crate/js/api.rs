@@ -446,3 +446,20 @@ pub fn spectrum(
     let result = crate::scenario::spectrum_for(&spec).map_err(js_error)?;
     to_js(&result)
 }
+
+/// `simulateCorner(spec)`: `spec = { path: { kind: "square", sideMm } | { kind:
+/// "ringingTower", sideMm?, thicknessMm? }, velocity, accel, squareCornerVelocity?, x: { modes,
+/// shaper? | impulses? }, y: (same), samplePeriodS?, settleS?, magnify? }` → `{ segments,
+/// duration, samplePeriodS, unshaped: { time, nozzle: [x, y], deviation, corners: [{ time,
+/// peakDeviation, ringing, windowS }], drawn }, shaped (same, or null), shaperX, shaperY }`:
+/// the path planned with Klipper's junction rule and printed unshaped and with each axis's
+/// shaper (crate::corner, crate::scenario::corner_for).
+#[cfg(feature = "js-api")]
+#[wasm_bindgen(js_name = simulateCorner, unchecked_return_type = "CornerResult")]
+pub fn simulate_corner(
+    #[wasm_bindgen(unchecked_param_type = "CornerSpec")] spec: JsValue,
+) -> Result<JsValue, JsValue> {
+    let spec: crate::scenario::CornerSpec = from_js_root(spec, "spec").map_err(js_error)?;
+    let result = crate::scenario::corner_for(&spec).map_err(js_error)?;
+    to_js(&result)
+}

@@ -75,7 +75,11 @@ pub(crate) fn number(value: &JsValue, field: &str) -> Result<f64, Error> {
 }
 
 /// A canvas argument: an `HTMLCanvasElement` (so never in Node).
-#[cfg(any(feature = "js-playground", feature = "js-recording"))]
+#[cfg(any(
+    feature = "js-playground",
+    feature = "js-recording",
+    feature = "js-corner"
+))]
 pub(crate) fn canvas(value: JsValue, field: &str) -> Result<web_sys::HtmlCanvasElement, Error> {
     value
         .dyn_into::<web_sys::HtmlCanvasElement>()

@@ -6,6 +6,7 @@
 //! - [`measure`]: its measured-data part (`parseRecording`, `welch`, `identifyModes`,
 //!   `recommendShaper`, `drawSpectrum`, …);
 //! - [`realise`]: the page's realisation view's chart (`drawRealisation`);
+//! - `corner`: the page's printed-corner view, `renderCorner` (feature `js-corner`);
 //! - [`playground`]: the page's frame, `renderPlayground`, in its stages;
 //! - `args`: the exports' arguments checked as what they must be (a string, a number, a
 //!   canvas, an array of numbers), whatever JS passes;
@@ -18,6 +19,8 @@
 pub mod api;
 pub(crate) mod args;
 pub(crate) mod canvas;
+#[cfg(feature = "js-corner")]
+pub mod corner;
 pub(crate) mod jsde;
 pub mod measure;
 #[cfg(feature = "js-playground")]
@@ -28,6 +31,8 @@ pub mod realise;
 // A build with only some of the export groups (Cargo features) may find one of them empty.
 #[allow(unused_imports)]
 pub use api::*;
+#[cfg(feature = "js-corner")]
+pub use corner::render_corner;
 #[allow(unused_imports)]
 pub use measure::*;
 #[cfg(feature = "js-playground")]

@@ -415,6 +415,103 @@ export interface SpectrumResult {
 }
 
 // ---------------------------------------------------------------------------------------------
+// The printed corner (simulateCorner)
+
+/** A toolpath in mm: a square from the origin, or Klipper's ringing tower's outline. */
+export type PathSpec =
+  | { kind: "square"; sideMm: number }
+  | { kind: "ringingTower"; sideMm?: number; thicknessMm?: number };
+
+export interface CornerAxisSpec {
+  modes: PlantModeSpec[];
+  shaper?: ShaperRequest | null;
+  impulses?: Impulse[] | null;
+}
+
+export interface CornerSpec {
+  path: PathSpec;
+  /** mm/s */
+  velocity: number;
+  /** mm/s² */
+  accel: number;
+  /** Klipper's square_corner_velocity, mm/s (default 5). */
+  squareCornerVelocity?: number;
+  x: CornerAxisSpec;
+  y: CornerAxisSpec;
+  samplePeriodS?: number | null;
+  settleS?: number | null;
+  magnify?: number | null;
+}
+
+export interface CornerSegment {
+  start: [number, number];
+  end: [number, number];
+  direction: [number, number];
+  length: number;
+  vStart: number;
+  vCruise: number;
+  vEnd: number;
+  tStart: number;
+  tAccel: number;
+  tCruise: number;
+  tDecel: number;
+}
+
+export interface CornerRinging {
+  time: number;
+  peakDeviation: number;
+  ringing: number;
+  windowS: number;
+}
+
+export interface CornerPrint {
+  time: number[];
+  nozzle: [number[], number[]];
+  deviation: number[];
+  corners: CornerRinging[];
+  /** The track with the deviation magnified (when `magnify` was given). */
+  drawn: [number[], number[]] | null;
+}
+
+export interface CornerResult {
+  segments: CornerSegment[];
+  duration: number;
+  samplePeriodS: number;
+  unshaped: CornerPrint;
+  shaped: CornerPrint | null;
+  shaperX: Shaper | null;
+  shaperY: Shaper | null;
+}
+
+/** renderCorner's options. */
+export interface CornerOptions {
+  pixelRatio?: number | null;
+  /** A label per shaper (default: the family's name). */
+  labels?: string[] | null;
+}
+
+export interface CornerPrintNumbers {
+  label: string;
+  corners: CornerRinging[];
+  /** Largest peak deviation over the corners (mm). */
+  peakDeviation: number;
+  /** Largest ringing over the corners (mm). */
+  ringing: number;
+}
+
+/** renderCorner's result: the numbers of the prints it drew. */
+export interface CornerFrame {
+  duration: number;
+  samplePeriodS: number;
+  /** The path speed at each corner (mm/s). */
+  junctionSpeeds: number[];
+  unshaped: CornerPrintNumbers;
+  shapers: CornerPrintNumbers[];
+  /** Shapers that could not be designed: why. */
+  leftOut: { label: string; index: number; field: string | null; message: string }[];
+}
+
+// ---------------------------------------------------------------------------------------------
 // The playground frame
 
 export interface PlaygroundView {

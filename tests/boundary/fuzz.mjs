@@ -138,6 +138,7 @@ function exportsTable(env) {
     { name: 'quantize', names: ['shaper', 'mode', 'options'], args: () => [shaper(), mode(), { amplitudeSteps: 255, tickS: 0.001 }] },
     { name: 'realizeShaper', names: [null, 'options'], args: () => [{ family: 'zv', modes: [{ frequencyHz: 60, damping: 0 }] }, { firmware: 'generic', periodS: 0.001, amplitudeSteps: 255, maxImpulses: 5, curve: { fromHz: 0, toHz: 150, points: 64 } }] },
     { name: 'simulate', names: [null], args: () => [{ plant: { kind: 'modal', modes: [{ frequencyHz: 4, damping: 0.05 }] }, command: { kind: 'trapezoid', distance: 1, maxVelocity: 1, maxAcceleration: 4 }, shaper: { family: 'zvd' }, sampleRateHz: 100 }] },
+    { name: 'simulateCorner', names: [null], args: () => [{ path: { kind: 'square', sideMm: 10 }, velocity: 100, accel: 3000, squareCornerVelocity: 5, x: { modes: [{ frequencyHz: 40, damping: 0.05 }], shaper: { family: 'zv' } }, y: { modes: [{ frequencyHz: 50, damping: 0.05 }] }, samplePeriodS: 0.002, magnify: 10 }] },
     { name: 'spectrum', names: [null], args: () => [{ command: { kind: 'step' }, shaper: { family: 'zvd', modes: [{ frequencyHz: 1 }] }, toHz: 5, points: 64 }] },
     { name: 'renderPlayground', names: [null, 'canvases'], args: () => [{ modes: [{ frequencyHz: 40, damping: 0.05 }], shapers: [{ family: 'zv' }], view: { vtol: 0.05, points: 50, samples: 200, mapFrequencyPoints: 8, mapDampingPoints: 4, dampingPoints: 8, spectrumPoints: 32 } }, {}] },
     { name: 'parseRecording', names: ['text', 'options'], aliases: { text: ['recording'] }, args: () => [text, { fileName: 'x.csv' }] },
@@ -146,6 +147,7 @@ function exportsTable(env) {
     { name: 'identifyModes', names: ['recording', 'options'], aliases: { recording: ['signal', 'spectrum'] }, args: () => [ring(), { sampleRateHz: 1000, segmentLength: 256 }] },
     { name: 'recommendShaper', names: ['spectrum', 'modes', 'options'], args: () => [spectrum(), [mode()], { families: [{ family: 'zv' }, { family: 'ei', vtol: 0.05 }] }] },
     { name: 'firmwareConfig', names: ['request'], args: () => [{ firmware: 'klipper', axes: [{ axis: 'x', family: 'mzv', frequencyHz: 53.8 }] }] },
+    { name: 'renderCorner', names: [null, 'shapers', 'canvas', 'options'], canvas: true, args: () => [{ path: { kind: 'square', sideMm: 10 }, velocity: 100, accel: 3000, x: { modes: [{ frequencyHz: 40, damping: 0.05 }] }, y: { modes: [{ frequencyHz: 50, damping: 0.05 }] }, samplePeriodS: 0.002 }, [{ family: 'zv' }], env.canvas(), { pixelRatio: 1 }] },
     { name: 'drawSpectrum', names: ['canvas', 'spectrum', 'options'], canvas: true, args: () => [env.canvas(), spectrum(), { peaksHz: [40] }] },
     // Its data's fields are named by their keys (`frequencyHz`, `shapers[0].values`), as documented.
     { name: 'drawKlipperChart', names: ['canvas', 'data', 'options'], canvas: true, aliases: { data: ['frequencyHz', 'psdSum', 'psdX', 'psdY', 'psdZ', 'after', 'shapers'] }, args: () => { const s = spectrum(); return [env.canvas(), { frequencyHz: s.frequencyHz, psdSum: s.psd }, { maxHz: 150 }]; } },

@@ -15,7 +15,9 @@ const CALLS = Number(process.env.BOUNDARY_CALLS ?? 3000);
 const SEED = Number(process.env.BOUNDARY_SEED ?? 20261204);
 const root = fileURLToPath(new URL('../../', import.meta.url));
 
-// The whole API, then the page's three modules (the same Rust, glue generated per module).
+// The whole API, then the page's three modules (the same Rust, glue generated per module). The
+// printed-corner module (pkg/page/corner) has one export, a drawing one: it is fuzzed in
+// Chromium (tests/e2e/boundary.test.mjs), where it has a canvas.
 const MODULES = [
   ['pkg/input_shaping', CALLS],
   ['pkg/page/playground', Math.ceil(CALLS / 4)],

@@ -14,6 +14,7 @@ const MODULES = [
   ['pkg/page/playground', Math.ceil(CALLS / 4)],
   ['pkg/page/designer', Math.ceil(CALLS / 10)],
   ['pkg/page/recording', Math.ceil(CALLS / 4)],
+  ['pkg/page/corner', Math.ceil(CALLS / 4)],
 ];
 
 let env;

@@ -19,6 +19,8 @@ import init, {
   realizeShaper,
   simulate,
   spectrum,
+  simulateCorner,
+  renderCorner,
   renderPlayground,
   parseRecording,
   RecordingParser,
@@ -121,6 +123,26 @@ export async function main(canvas: HTMLCanvasElement): Promise<void> {
   const swing: number[] | undefined = crane.unshaped.swingAngle;
   const u = spectrum({ command: { kind: "step" }, shaper: { family: "zv", modes: [mode] }, toHz: 10 });
   console.log(residual, swing, u.magnitude[0]);
+
+  // The printed corner: a path discriminated by `kind`, each axis with its modes and shaper.
+  const print = simulateCorner({
+    path: { kind: "ringingTower" },
+    velocity: 100,
+    accel: 3000,
+    x: { modes: [{ frequencyHz: 42, damping: 0.06 }], shaper: { family: "mzv" } },
+    y: { modes: [{ frequencyHz: 55, damping: 0.05 }], impulses: [{ time: 0, amplitude: 1 }] },
+    magnify: 50,
+  });
+  const ringing: number | undefined = print.shaped?.corners[0].ringing;
+  const drawn: [number[], number[]] | null = print.unshaped.drawn;
+  console.log(ringing, drawn, print.segments[1].vStart, print.shaperX?.duration);
+  const cornerFrame = renderCorner(
+    { path: { kind: "square", sideMm: 40 }, velocity: 150, accel: 5000, x: { modes: [mode] }, y: { modes: [mode] } },
+    [{ family: "zv" }, { family: "ei", vtol: 0.05 }],
+    canvas,
+    { pixelRatio: 2, labels: ["ZV", "EI"] },
+  );
+  console.log(cornerFrame.shapers[0].ringing, cornerFrame.leftOut.length, cornerFrame.junctionSpeeds[0]);
 
   // The playground frame.
   const frame = renderPlayground(
