@@ -150,6 +150,27 @@ enum SeqAccess {
     },
 }
 
+/// The longest sequence (array, typed array or iterable) read from JS: the longest array an
+/// export's own arguments take ([`super::args::MAX_ARRAY_LENGTH`], 2²⁶). Longer is an error of
+/// that field before any element is read: the one difference from serde-wasm-bindgen, which
+/// reads until memory runs out.
+pub(crate) const MAX_SEQUENCE_LENGTH: usize = super::args::MAX_ARRAY_LENGTH;
+
+/// What [`check_length`]'s error expects.
+const TOO_LONG: &str = "at most 67108864 elements";
+const _: () = assert!(MAX_SEQUENCE_LENGTH == 67_108_864);
+
+/// [`MAX_SEQUENCE_LENGTH`], checked on a sequence's length before it is read.
+fn check_length(length: f64) -> Result<()> {
+    if length > MAX_SEQUENCE_LENGTH as f64 {
+        return Err(note(de::Error::invalid_length(
+            length.min(u64::MAX as f64) as usize,
+            &TOO_LONG,
+        )));
+    }
+    Ok(())
+}
+
 impl SeqAccess {
     fn array(array: Array) -> Self {
         let len = array.length();
@@ -180,6 +201,10 @@ impl<'de> de::SeqAccess<'de> for SeqAccess {
                 }
                 *left -= 1;
                 return seed.deserialize(De::new(value.clone(), true)).map(Some);
+            }
+            SeqAccess::Iter(_, next) if *next >= MAX_SEQUENCE_LENGTH => {
+                // An endless iterable (a generator) stops here, not at memory's end.
+                return Err(de::Error::invalid_length(*next + 1, &TOO_LONG));
             }
             SeqAccess::Iter(iter, next) => match iter.next() {
                 None => return Ok(None),
@@ -553,8 +578,19 @@ impl De {
 
     fn seq<'de, V: Visitor<'de>>(self, visitor: V) -> Result<V::Value> {
         if let Some(arr) = self.value.dyn_ref::<Array>() {
+            check_length(arr.length() as f64)?;
             visitor.visit_seq(SeqAccess::array(arr.clone()))
         } else if let Some(iter) = js_sys::try_iter(&self.value)? {
+            if ArrayBuffer::is_view(&self.value) {
+                // A typed array's `length`, read before its elements are: 2²⁶ + 1 of them would
+                // otherwise grow a `Vec` to a gigabyte, which a browser's wasm memory may refuse
+                // (an abort: a trap, found by the 10⁶-call boundary profile in Chromium).
+                let length = js_sys::Reflect::get(&self.value, &JsValue::from_str("length"))
+                    .ok()
+                    .and_then(|l| l.as_f64())
+                    .unwrap_or(0.0);
+                check_length(length)?;
+            }
             visitor.visit_seq(SeqAccess::Iter(iter, 0))
         } else {
             self.invalid_type(visitor)
