@@ -444,12 +444,11 @@ fn sqp(setup: &Setup, y0: Vec<f64>) -> Option<Solved> {
             let capped = null_step.amax() >= cap * (1.0 - 1e-12);
             let step = optimality_step(setup, &y, &lin, &dy_range, &null_step, c_max);
             if !reference_polish() {
-                cap = match step {
-                    Some((_, alpha)) if alpha == 1.0 && capped => {
-                        (2.0 * cap).min(LARGEST_NULL_STEP)
-                    }
-                    Some((_, alpha)) if alpha == 1.0 => cap,
-                    _ => (0.5 * cap).max(MAX_NULL_STEP),
+                let full = matches!(step, Some((_, alpha)) if alpha == 1.0);
+                cap = match (full, capped) {
+                    (true, true) => (2.0 * cap).min(LARGEST_NULL_STEP),
+                    (true, false) => cap,
+                    (false, _) => (0.5 * cap).max(MAX_NULL_STEP),
                 };
             }
             (step.map(|(t, _)| t), 1e3)
