@@ -66,22 +66,29 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-/// The three-mode designs take 0.1–1 s each: ten samples.
+/// The three-mode designs take 0.1–1 s each: ten samples. Each is timed twice in the same run:
+/// with the current polish (`i0.3`) and with the polish before issue 24's speed work
+/// (`i0.3_reference`: the four-point Hessian stencil, a fixed null-step cap), selected by
+/// `input_shaping::solve::set_reference_polish`.
 #[cfg(not(target_arch = "wasm32"))]
 fn bench_three_modes(c: &mut Criterion) {
     let mut group = c.benchmark_group("si_three_modes");
     group.sample_size(10);
     for i in [0.3, 0.7] {
         let req = three_modes(i);
-        let s = design(&req).expect("design");
-        eprintln!(
-            "si three modes I {i}: duration {:.6} s, {} impulses",
-            s.duration(),
-            s.len()
-        );
-        group.bench_function(format!("i{i}"), |b| {
-            b.iter(|| design(black_box(&req)).expect("design"))
-        });
+        for (suffix, reference) in [("_reference", true), ("", false)] {
+            input_shaping::solve::set_reference_polish(reference);
+            let s = design(&req).expect("design");
+            eprintln!(
+                "si three modes I {i}{suffix}: duration {:.6} s, {} impulses",
+                s.duration(),
+                s.len()
+            );
+            group.bench_function(format!("i{i}{suffix}"), |b| {
+                b.iter(|| design(black_box(&req)).expect("design"))
+            });
+        }
+        input_shaping::solve::set_reference_polish(false);
     }
     group.finish();
 }

@@ -480,6 +480,14 @@ pub fn minimum_duration(problem: &Problem) -> Result<Design> {
     shortest(norm)
 }
 
+/// Selects the polish as it was before issue 24's speed work (`true`: the four-point Hessian
+/// stencil and a fixed null-step cap) or the current one (`false`, the default), process-wide.
+/// For benchmarks that time both in one run (`benches/si.rs`); not part of the API.
+#[doc(hidden)]
+pub fn set_reference_polish(on: bool) {
+    polish::set_reference_polish(on);
+}
+
 /// Without the solver: nothing below is compiled into the wasm.
 #[cfg(not(feature = "solver"))]
 fn shortest(_: NormalizedProblem) -> Result<Design> {

@@ -23,6 +23,7 @@ use super::{
 use crate::shaper::Impulse;
 use crate::vibration::{impulse_phasor, vibration_moments};
 use nalgebra::{DMatrix, DVector};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Most clusters split in two when looking for a structure that polishes.
 const MAX_SPLITS: usize = 2;
@@ -45,10 +46,28 @@ const RESTORATION_THRESHOLD: f64 = 1e-4;
 /// Largest null-space step per unknown (normalized units: periods of the highest frequency,
 /// amplitudes, rad per period).
 const MAX_NULL_STEP: f64 = 0.05;
+/// Largest the null-space step's cap grows to after full steps (the reference path keeps
+/// [`MAX_NULL_STEP`]).
+const LARGEST_NULL_STEP: f64 = 0.8;
 /// Finite-difference step for the Jacobian.
 const JACOBIAN_STEP: f64 = 1e-7;
 /// Finite-difference step for the reduced Hessian.
 const HESSIAN_STEP: f64 = 1e-4;
+
+/// The polish as it was before issue 24's speed work (the four-point Hessian stencil, a fixed
+/// null-step cap), for benchmarks that compare the two in one run.
+static REFERENCE_POLISH: AtomicBool = AtomicBool::new(false);
+
+/// Whether the reference (previous) polish is selected.
+fn reference_polish() -> bool {
+    REFERENCE_POLISH.load(Ordering::Relaxed)
+}
+
+/// Selects the previous polish (`true`) or the current one (`false`, the default), process-wide.
+/// For benchmarks only (`benches/si.rs`): both give the same guarantees.
+pub(crate) fn set_reference_polish(on: bool) {
+    REFERENCE_POLISH.store(on, Ordering::Relaxed);
+}
 
 /// A coordinate of an active point: fixed, or the unknown at `index` of y.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -395,6 +414,9 @@ fn sqp(setup: &Setup, y0: Vec<f64>) -> Option<Solved> {
         return None;
     }
     let (mut best_c, mut since_best) = (f64::INFINITY, 0);
+    // The null-space step's cap (a trust radius): doubled after a full step, back towards
+    // MAX_NULL_STEP after a shortened one, never below it.
+    let mut cap = MAX_NULL_STEP;
     for _ in 0..MAX_NEWTON_ITERATIONS {
         let c = DVector::from_vec(setup.residuals(&y));
         let lin = Linearization::new(setup.jacobian(&y), &grad_f)?;
@@ -418,11 +440,18 @@ fn sqp(setup: &Setup, y0: Vec<f64>) -> Option<Solved> {
         let (next, gradient_slack) = if c_max > RESTORATION_THRESHOLD || lin.null.is_empty() {
             (restoration_step(setup, &y, &dy_range, c_max), 1.0)
         } else {
-            let null_step = null_space_step(setup, &y, &lin, &gz);
-            (
-                optimality_step(setup, &y, &lin, &dy_range, &null_step, c_max),
-                1e3,
-            )
+            let null_step = null_space_step(setup, &y, &lin, &gz, cap);
+            let capped = null_step.amax() >= cap * (1.0 - 1e-12);
+            let step = optimality_step(setup, &y, &lin, &dy_range, &null_step, c_max);
+            if !reference_polish() {
+                let full = matches!(step, Some((_, alpha)) if alpha == 1.0);
+                cap = match (full, capped) {
+                    (true, true) => (2.0 * cap).min(LARGEST_NULL_STEP),
+                    (true, false) => cap,
+                    (false, _) => (0.5 * cap).max(MAX_NULL_STEP),
+                };
+            }
+            (step.map(|(t, _)| t), 1e3)
         };
         match next {
             Some(t) => y = t,
@@ -473,7 +502,13 @@ fn restoration_step(
 /// The Newton step on t_n in the null space of J at `y`: the reduced Hessian of the
 /// Lagrangian L = t_n − λ·c by central differences, its eigenvalues floored by magnitude (a
 /// minimum, not a saddle), the step capped at [`MAX_NULL_STEP`].
-fn null_space_step(setup: &Setup, y: &[f64], lin: &Linearization, gz: &[f64]) -> DVector<f64> {
+fn null_space_step(
+    setup: &Setup,
+    y: &[f64],
+    lin: &Linearization,
+    gz: &[f64],
+    cap: f64,
+) -> DVector<f64> {
     // t_n is linear: only −λ·c is curved.
     let lag = |yy: &[f64]| -> f64 {
         let r = setup.residuals(yy);
@@ -482,27 +517,11 @@ fn null_space_step(setup: &Setup, y: &[f64], lin: &Linearization, gz: &[f64]) ->
             .map(|(a, b)| a * b)
             .sum::<f64>()
     };
-    let nz = lin.null.len();
-    let mut hz = DMatrix::zeros(nz, nz);
-    let h = HESSIAN_STEP;
-    let shifted = |a: &DVector<f64>, b: &DVector<f64>, sa: f64, sb: f64| -> Vec<f64> {
-        y.iter()
-            .enumerate()
-            .map(|(i, &v)| v + h * (sa * a[i] + sb * b[i]))
-            .collect()
+    let hz = if reference_polish() {
+        reduced_hessian_four_point(y, &lin.null, &lag)
+    } else {
+        reduced_hessian(y, &lin.null, &lag)
     };
-    for p in 0..nz {
-        for q in p..nz {
-            let (a, b) = (&lin.null[p], &lin.null[q]);
-            let val = (lag(&shifted(a, b, 1.0, 1.0))
-                - lag(&shifted(a, b, 1.0, -1.0))
-                - lag(&shifted(a, b, -1.0, 1.0))
-                + lag(&shifted(a, b, -1.0, -1.0)))
-                / (4.0 * h * h);
-            hz[(p, q)] = val;
-            hz[(q, p)] = val;
-        }
-    }
     // Positive definite (a minimum, not a saddle): eigenvalues by magnitude, floored.
     let eig = hz.symmetric_eigen();
     let emax = eig
@@ -510,8 +529,8 @@ fn null_space_step(setup: &Setup, y: &[f64], lin: &Linearization, gz: &[f64]) ->
         .iter()
         .fold(0.0_f64, |a, &b| a.max(b.abs()))
         .max(1e-6);
-    let mut pz = DVector::zeros(nz);
-    for k in 0..nz {
+    let mut pz = DVector::zeros(lin.null.len());
+    for k in 0..lin.null.len() {
         let e = eig.eigenvalues[k].abs().max(1e-6 * emax);
         let vk = eig.eigenvectors.column(k);
         let g: f64 = vk.iter().zip(gz).map(|(a, b)| a * b).sum();
@@ -522,16 +541,86 @@ fn null_space_step(setup: &Setup, y: &[f64], lin: &Linearization, gz: &[f64]) ->
         null_step += z * pz[k];
     }
     let big = null_step.amax();
-    if big > MAX_NULL_STEP {
-        null_step *= MAX_NULL_STEP / big;
+    if big > cap {
+        null_step *= cap / big;
     }
     null_step
+}
+
+/// L at y + h·(sa·a + sb·b).
+fn shifted(y: &[f64], a: &DVector<f64>, b: &DVector<f64>, sa: f64, sb: f64) -> Vec<f64> {
+    y.iter()
+        .enumerate()
+        .map(|(i, &v)| v + HESSIAN_STEP * (sa * a[i] + sb * b[i]))
+        .collect()
+}
+
+/// The reduced Hessian Zᵀ∇²L Z by central differences along the null-space basis `null`, the
+/// previous stencil (the reference path): four evaluations of L per entry,
+/// H_pq ≈ [L(+p+q) − L(+p−q) − L(−p+q) + L(−p−q)] / 4h², nz(nz+1)/2 entries.
+fn reduced_hessian_four_point(
+    y: &[f64],
+    null: &[DVector<f64>],
+    lag: &dyn Fn(&[f64]) -> f64,
+) -> DMatrix<f64> {
+    let nz = null.len();
+    let h = HESSIAN_STEP;
+    let mut hz = DMatrix::zeros(nz, nz);
+    for p in 0..nz {
+        for q in p..nz {
+            let (a, b) = (&null[p], &null[q]);
+            let val = (lag(&shifted(y, a, b, 1.0, 1.0))
+                - lag(&shifted(y, a, b, 1.0, -1.0))
+                - lag(&shifted(y, a, b, -1.0, 1.0))
+                + lag(&shifted(y, a, b, -1.0, -1.0)))
+                / (4.0 * h * h);
+            hz[(p, q)] = val;
+            hz[(q, p)] = val;
+        }
+    }
+    hz
+}
+
+/// The reduced Hessian Zᵀ∇²L Z by central differences with shared evaluations: L(y),
+/// L(y ± h z_p) for every p, and L(y ± h(z_p + z_q)) for p < q, then
+///
+///   H_pp ≈ [L(+p) − 2L + L(−p)] / h²,
+///   H_pq ≈ [L(+p+q) + L(−p−q) − L(+p) − L(−p) − L(+q) − L(−q) + 2L] / 2h²,
+///
+/// both exact for quadratics and O(h²) otherwise (Taylor: the odd terms cancel between the
+/// ± pairs; the second is ½[D²(z_p+z_q) − D²z_p − D²z_q]). 1 + nz² evaluations instead of the
+/// four-point stencil's 2nz(nz+1).
+fn reduced_hessian(y: &[f64], null: &[DVector<f64>], lag: &dyn Fn(&[f64]) -> f64) -> DMatrix<f64> {
+    let nz = null.len();
+    let h = HESSIAN_STEP;
+    let zero = DVector::zeros(y.len());
+    let l0 = lag(y);
+    let plus: Vec<f64> = null
+        .iter()
+        .map(|a| lag(&shifted(y, a, &zero, 1.0, 0.0)))
+        .collect();
+    let minus: Vec<f64> = null
+        .iter()
+        .map(|a| lag(&shifted(y, a, &zero, -1.0, 0.0)))
+        .collect();
+    let mut hz = DMatrix::zeros(nz, nz);
+    for p in 0..nz {
+        hz[(p, p)] = (plus[p] - 2.0 * l0 + minus[p]) / (h * h);
+        for q in p + 1..nz {
+            let (a, b) = (&null[p], &null[q]);
+            let both = lag(&shifted(y, a, b, 1.0, 1.0)) + lag(&shifted(y, a, b, -1.0, -1.0));
+            let val = (both - plus[p] - minus[p] - plus[q] - minus[q] + 2.0 * l0) / (2.0 * h * h);
+            hz[(p, q)] = val;
+            hz[(q, p)] = val;
+        }
+    }
+    hz
 }
 
 /// Near c = 0: the Gauss–Newton step plus α times `null_step`, pulled back onto c = 0, with α
 /// halved until t_n beats the restored point without the null-space step (or, if that cannot
 /// be restored, the current one). Without such an α, the restored point itself while c is
-/// not yet at its tolerance; `None` otherwise.
+/// not yet at its tolerance (α = 0); `None` otherwise. Returns the point and α.
 fn optimality_step(
     setup: &Setup,
     y: &[f64],
@@ -539,7 +628,7 @@ fn optimality_step(
     dy_range: &DVector<f64>,
     null_step: &DVector<f64>,
     c_max: f64,
-) -> Option<Vec<f64>> {
+) -> Option<(Vec<f64>, f64)> {
     let di = setup.duration_index();
     // A trial point: the Gauss–Newton step plus α times the null-space step, pulled back
     // onto c = 0 with the current Jacobian (chord iterations).
@@ -574,12 +663,13 @@ fn optimality_step(
                 None => trial[di] < y[di],
             };
             if beats {
-                return Some(trial);
+                return Some((trial, alpha));
             }
         }
         alpha *= 0.5;
     }
     base.filter(|_| c_max > RESIDUAL_TOLERANCE)
+        .map(|b| (b, 0.0))
 }
 
 /// The state of the active-set loop: impulses and active points.
@@ -1104,6 +1194,68 @@ pub(crate) fn project_equalities(norm: &NormalizedProblem, impulses: &mut [Impul
         let delta = e.transpose() * w;
         for (imp, d) in impulses.iter_mut().zip(delta.iter()) {
             imp.amplitude += d;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A smooth non-quadratic test function with a closed-form Hessian:
+    /// f(y) = e^{y₀} sin(y₁) + y₀² y₂ + cos(y₁ y₂).
+    fn f(y: &[f64]) -> f64 {
+        y[0].exp() * y[1].sin() + y[0] * y[0] * y[2] + (y[1] * y[2]).cos()
+    }
+
+    fn hessian(y: &[f64]) -> DMatrix<f64> {
+        let (a, b, c) = (y[0], y[1], y[2]);
+        let (s, k) = ((b * c).sin(), (b * c).cos());
+        DMatrix::from_row_slice(
+            3,
+            3,
+            &[
+                a.exp() * b.sin() + 2.0 * c,
+                a.exp() * b.cos(),
+                2.0 * a,
+                a.exp() * b.cos(),
+                -a.exp() * b.sin() - c * c * k,
+                -s - b * c * k,
+                2.0 * a,
+                -s - b * c * k,
+                -b * b * k,
+            ],
+        )
+    }
+
+    /// Both stencils against Zᵀ H Z in closed form, along an orthonormal basis that is not the
+    /// unit vectors (as the null-space bases are). O(h²) with h = 1e-4: errors ~1e-8, plus
+    /// rounding ε·|f|/h² ~ 1e-8.
+    #[test]
+    fn reduced_hessian_matches_closed_form() {
+        let y = [0.3, 0.7, -0.4];
+        let r = 0.5_f64.sqrt();
+        let null = vec![
+            DVector::from_vec(vec![r, r, 0.0]),
+            DVector::from_vec(vec![r, -r, 0.0]),
+            DVector::from_vec(vec![0.0, 0.0, 1.0]),
+        ];
+        let z = DMatrix::from_columns(&null);
+        let exact = z.transpose() * hessian(&y) * &z;
+        let shared = reduced_hessian(&y, &null, &f);
+        let four = reduced_hessian_four_point(&y, &null, &f);
+        for (p, q) in (0..3).flat_map(|p| (0..3).map(move |q| (p, q))) {
+            let e = exact[(p, q)];
+            assert!(
+                (shared[(p, q)] - e).abs() < 1e-6,
+                "shared ({p},{q}): {} vs {e}",
+                shared[(p, q)]
+            );
+            assert!(
+                (four[(p, q)] - e).abs() < 1e-6,
+                "four-point ({p},{q}): {} vs {e}",
+                four[(p, q)]
+            );
         }
     }
 }

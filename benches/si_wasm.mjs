@@ -1,0 +1,40 @@
+// Issue 24 item 1 in wasm: `si` over three modes (1.2 / 3.4 / 7.9 Hz, ζ 0.02, Vtol 5 %) at
+// I 0.3 and 0.7, timed in node with the whole-API module, two builds side by side in one run
+// (alternating, so both see the same load): e.g. main's pkg (the old path) and this branch's.
+//
+//   bash scripts/build.sh --library          # this branch's pkg/input_shaping.js
+//   node benches/si_wasm.mjs OLD/input_shaping.js pkg/input_shaping.js
+//
+// Prints per build and case the median and minimum of RUNS (default 5) runs after one warm-up
+// (wall clock), and the design's duration and impulse count (which must agree).
+import { readFileSync } from 'node:fs';
+import path from 'node:path';
+
+const RUNS = Number(process.env.RUNS ?? 5);
+const modules = process.argv.slice(2);
+if (modules.length === 0) modules.push('pkg/input_shaping.js');
+const loaded = [];
+for (const m of modules) {
+  const p = path.resolve(m);
+  const mod = await import(p);
+  await mod.default({ module_or_path: readFileSync(p.replace(/\.js$/, '_bg.wasm')) });
+  loaded.push({ name: m, mod });
+}
+const modes = [1.2, 3.4, 7.9].map((f) => ({ frequencyHz: f, damping: 0.02 }));
+const cases = [0.3, 0.7].map((i) => ({ name: `si three modes I ${i}`, spec: { family: 'si', modes, vtol: 0.05, insensitivity: i } }));
+for (const c of cases) {
+  const times = loaded.map(() => []);
+  const results = loaded.map(({ mod }) => mod.design(c.spec)); // warm-up
+  for (let r = 0; r < RUNS; r++) {
+    loaded.forEach(({ mod }, k) => {
+      const t0 = performance.now();
+      mod.design(c.spec);
+      times[k].push(performance.now() - t0);
+    });
+  }
+  loaded.forEach(({ name }, k) => {
+    const s = [...times[k]].sort((a, b) => a - b);
+    const res = results[k];
+    console.log(`${c.name} | ${name} | median ${s[s.length >> 1].toFixed(0)} ms, min ${s[0].toFixed(0)} ms | ${res.duration.toFixed(6)} s, ${res.impulses.length} impulses`);
+  });
+}
