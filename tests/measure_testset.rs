@@ -477,11 +477,20 @@ fn the_sweeps_end_is_not_a_mode() {
                     .filter(|m| m.0 > 129.0)
                     .map(|m| (name.clone(), m.0, m.1)),
             );
-            t.check(&name, "synthetic", &truth, &found, 0.5 * spectrum.resolution_hz);
+            t.check(
+                &name,
+                "synthetic",
+                &truth,
+                &found,
+                0.5 * spectrum.resolution_hz,
+            );
         }
     }
     t.print_rows(false);
-    assert!(at_cliff.is_empty(), "modes at the sweep's end: {at_cliff:?}");
+    assert!(
+        at_cliff.is_empty(),
+        "modes at the sweep's end: {at_cliff:?}"
+    );
     assert_eq!(t.spurious.len(), 0, "spurious modes");
     assert_eq!(t.within(), t.rows.len(), "modes outside the targets");
     // The generated file (benches/reference/sweep_testset.py, case cliff133: Klipper's sweep
@@ -492,7 +501,13 @@ fn the_sweeps_end_is_not_a_mode() {
     ] {
         let (found, half_bin) = identify_file("x_cliff133", file, "x", MAX_MODES);
         let mut t = Tally::default();
-        t.check("x_cliff133", "file", &[(45.0, 0.05), (123.0, 0.03)], &found, half_bin);
+        t.check(
+            "x_cliff133",
+            "file",
+            &[(45.0, 0.05), (123.0, 0.03)],
+            &found,
+            half_bin,
+        );
         t.print_rows(false);
         assert!(found.iter().all(|m| m.0 < 129.0), "{file}: {found:?}");
         assert_eq!(t.within(), 2, "{file}: {found:?}");

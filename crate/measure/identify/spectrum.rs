@@ -213,7 +213,10 @@ pub(super) fn sweep_end(grid: &Grid, lo: usize, hi: usize) -> Option<usize> {
             .map(|j| w[j] - w[..j].iter().cloned().fold(f64::INFINITY, f64::min))
             .fold(f64::NEG_INFINITY, f64::max);
         let before = db[k - 3] - db[k];
-        let after = db[k + 3..k + 9].iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let after = db[k + 3..k + 9]
+            .iter()
+            .cloned()
+            .fold(f64::NEG_INFINITY, f64::max);
         fall >= 8.0 && rise <= 3.0 && fall >= 2.0 * before && after <= db[k] - 6.0
     })?;
     let drop = |j: usize| db[j] - db[j + 1];
