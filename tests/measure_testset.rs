@@ -298,9 +298,9 @@ fn bessel_i0(x: f64) -> f64 {
 /// at `fs`, its kernel |W(ν)|² summed over ±6 bins in steps of 1/16 bin) of a base-excited
 /// accelerometer under Klipper's sweep, S(f) = f²·|1 − Σ gᵢ s²/(s² + 2ζᵢωᵢs + ωᵢ²)|² + B,
 /// times Gamma(k, 1/k) noise per bin (k segments averaged). The sweep ends at `sweep_end_hz`
-/// (`f64::INFINITY`: past the file's last row): above it the excitation, and with it the
-/// f²·|H|² term, is 0 and only the floor B is left (as in Klipper's releases of 2021–2023,
-/// which swept to 133.33 Hz and wrote rows to 200 Hz).
+/// (`f64::INFINITY`: past the file's last row): the f²·|H|² term tapers (half cosine) over
+/// its last 3 Hz to 1 % past it (as Klipper's releases of 2021–2023 show, which swept to
+/// 133.33 Hz and wrote rows to 200 Hz).
 fn synthetic_resonances(
     modes: &[(f64, f64, f64)],
     floor: f64,
@@ -337,9 +337,17 @@ fn synthetic_resonances(
     kern.iter_mut().for_each(|v| *v /= total);
     let true_psd = |f: f64| {
         let f = f.abs();
-        if f > sweep_end_hz {
-            return floor;
-        }
+        // The excitation's end as the real files show it (docs/measured-data.md: 10–30 dB
+        // within 2–3 bins, then the level of what is left, harmonics and fans, 20 dB down):
+        // a half-cosine taper over the last 3 Hz to 1 % of the sweep's power.
+        let taper = if f >= sweep_end_hz {
+            0.01
+        } else if f > sweep_end_hz - 3.0 {
+            let x = (sweep_end_hz - f) / 3.0;
+            0.01 + 0.99 * 0.5 * (1.0 - (std::f64::consts::PI * x).cos())
+        } else {
+            1.0
+        };
         let (mut hr, mut hi) = (1.0, 0.0);
         for &(fi, z, g) in modes {
             // s²/(s² + 2ζωs + ω²) at s = iω_f: −f²/(fi² − f² + 2iζ fi f).
@@ -348,7 +356,7 @@ fn synthetic_resonances(
             hr += g * f * f * dr / d2;
             hi -= g * f * f * di / d2;
         }
-        f * f * (hr * hr + hi * hi) + floor
+        taper * f * f * (hr * hr + hi * hi) + floor
     };
     let mut text = String::from("freq,psd_x,psd_y,psd_z,psd_xyz\n");
     for bin in 0..=(300.0 / df) as usize {
