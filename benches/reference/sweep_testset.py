@@ -368,6 +368,13 @@ def cases():
         c.append(dict(name=name, axis=axis, rate=3200.0, seed=seed, noise=150.0, modes=modes,
                       excitation=FULL, outputs=outs, note=note + "; " + full))
     c[-1]["drift"] = {"offset": -40.0, "slope": -2.0, "sine": 35.0, "period": 55.0}
+    # Klipper's releases of 2021-2023 swept to 133.33 Hz (max_freq = 1.5 * 133.33 = 200 Hz of
+    # rows): the PSD falls off a cliff at the sweep's end; a genuine mode 10 Hz under it
+    c.append(dict(name="cliff133", axis="x", rate=3200.0, seed=209, noise=150.0,
+                  modes=[mode(45.0, 0.05, 12.0), mode(123.0, 0.03, 14.0)],
+                  excitation=exc(5.0, 133.33), outputs=["resonances", "calibration_data"],
+                  note="sweep 5-133.33 Hz at 1 Hz/s (Klipper 2021-2023's default band), "
+                       "a mode 10 Hz under its end; " + full.replace("5-200", "5-133.33")))
     c.append(dict(name="noisy47", axis="y", rate=3200.0, seed=208, noise=400.0,
                   modes=[mode(47.3, 0.08, 14.0)], excitation=FULL, outputs=["resonances"],
                   note="single mode, noise 400 mm/s^2 (PSD floor ~100); " + full))

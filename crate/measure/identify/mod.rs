@@ -496,7 +496,12 @@ pub fn identify_spectrum(
     if hi < lo + 4 {
         return Ok(result);
     }
-    let (halves, mut slots) = spectrum::seeds(&grid, lo, hi, options);
+    // The sweep's end (if the file shows one): no peak searched, no bin fitted past it.
+    let (cut, f_hi) = match spectrum::sweep_end(&grid, lo, hi) {
+        Some(e) if e >= lo + 5 => (Some(e - 1), psd.frequency_hz[e - 1]),
+        _ => (None, f_hi),
+    };
+    let (halves, mut slots) = spectrum::seeds(&grid, lo, hi, cut, options);
     let input = ModelInput {
         frequency_hz: &psd.frequency_hz,
         psd: &psd.psd,

@@ -3,7 +3,7 @@
 
 use super::half_power::{half_power, HalfPower};
 use super::model::WindowSpec;
-use super::peaks::detect;
+use super::peaks::detect_within;
 use super::{IdentifyOptions, Slot};
 use crate::error::{count, positive, Error, Result};
 use crate::measure::psd::{window, Psd, WindowKind, MAX_SEGMENT_LENGTH};
@@ -106,10 +106,17 @@ pub(super) fn band(grid: &Grid, options: &IdentifyOptions) -> Result<[f64; 2]> {
 /// the un-normalised PSD; 3-bin smoothing: Klipper's bins are coarse) in bins `lo..=hi`, and
 /// their half-power seeds, one per maximum. Leakage widens a narrow peak to the kernel's
 /// width: a seed's damping is an upper bound, kept as it is.
+///
+/// With the sweep's end found ([`sweep_end`]; `cut` the last bin before it), peaks are
+/// searched in `lo..=cut` only, their prominence still read over `lo..=hi` (a mode just under
+/// the end has its high side's base past the cliff), and kept only when the PSD falls ≥ 3 dB
+/// between them and bin `cut`: their half-power point on the high side lies in the fitted bins. The cliff's
+/// shoulder, flat up to the cliff, is no such peak.
 pub(super) fn seeds(
     grid: &Grid,
     lo: usize,
     hi: usize,
+    cut: Option<usize>,
     options: &IdentifyOptions,
 ) -> (Vec<HalfPower>, Vec<Slot>) {
     let psd = &grid.psd;
@@ -123,14 +130,27 @@ pub(super) fn seeds(
             .collect(),
         ..psd.clone()
     };
-    let peaks = detect(
+    let top = cut.unwrap_or(hi);
+    let peaks: Vec<_> = detect_within(
         &unnormalized,
-        lo,
-        hi,
+        [lo, top],
+        [lo, hi],
         options.min_prominence_db,
         options.max_modes,
         1,
-    );
+    )
+    .into_iter()
+    .filter(|pk| {
+        let k = (pk.frequency_hz / df).round() as usize;
+        cut.is_none_or(|c| {
+            let low = unnormalized.psd[k.min(c)..=c]
+                .iter()
+                .cloned()
+                .fold(f64::INFINITY, f64::min);
+            unnormalized.psd[k] >= low * 10f64.powf(0.3)
+        })
+    })
+    .collect();
     let mut slots = Vec::new();
     let mut halves: Vec<HalfPower> = Vec::new();
     for pk in &peaks {
@@ -139,7 +159,7 @@ pub(super) fn seeds(
             pk.frequency_hz,
             2.0 * df,
             lo,
-            hi,
+            top,
             options.signal,
         ) else {
             continue;
@@ -155,4 +175,51 @@ pub(super) fn seeds(
         }
     }
     (halves, slots)
+}
+
+/// The end of the sweep in a spectrum file, the last bin before it (`None` when there is
+/// none). Klipper's releases of 2021–2023 swept to 133.33 Hz and wrote rows to 200 Hz; its
+/// PSD falls off a cliff there, smeared over 2–3 bins by the window, and a modal fit reads the
+/// cliff's shoulder as a lightly damped mode. A mode cannot make that shape: its high side
+/// falls no faster than its low side rises (a narrow peak is the window's symmetric kernel),
+/// then flattens to its f⁻⁴ (PSD) asymptote. So a cliff at bin k is, on the un-normalised
+/// PSD, going up from the band's start: a fall of ≥ 8 dB from k to k + 3 (≥ 8 dB over
+/// 3 bins: 2.3–3.5 % of 133 Hz, hundreds of dB per decade), after no rise of more than 3 dB
+/// anywhere over k − 5..k (not a peak's flank: a peak that sharp rises as fast as it falls),
+/// at least twice the fall over k − 3..k (the slope steepens abruptly: not a mode's high side,
+/// whose fall per bin lessens away from its peak), and staying ≥ 6 dB under bin k for 6 bins
+/// past k + 3 (not an anti-resonance between two modes, whose notch comes back up). Returned:
+/// the bin before the steepest one-bin drop of those 3, already inside the window's smear of
+/// the cliff; the caller fits up to the bin before it.
+/// Measured on 11 public Klipper files (docs/measured-data.md, *On real recordings*).
+pub(super) fn sweep_end(grid: &Grid, lo: usize, hi: usize) -> Option<usize> {
+    let psd = &grid.psd;
+    let db: Vec<f64> = psd
+        .psd
+        .iter()
+        .zip(&psd.frequency_hz)
+        .map(|(v, f)| {
+            let v = if grid.normalized { v * (f + 0.1) } else { *v };
+            10.0 * v.max(1e-300).log10()
+        })
+        .collect();
+    let n = db.len();
+    let start = lo.max(5);
+    let end = hi.min(n.saturating_sub(10));
+    let k = (start..end).find(|&k| {
+        let fall = db[k] - db[k + 3];
+        let w = &db[k - 5..=k];
+        let rise = (1..w.len())
+            .map(|j| w[j] - w[..j].iter().cloned().fold(f64::INFINITY, f64::min))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let before = db[k - 3] - db[k];
+        let after = db[k + 3..k + 9]
+            .iter()
+            .cloned()
+            .fold(f64::NEG_INFINITY, f64::max);
+        fall >= 8.0 && rise <= 3.0 && fall >= 2.0 * before && after <= db[k] - 6.0
+    })?;
+    let drop = |j: usize| db[j] - db[j + 1];
+    let k = (k..k + 3).fold(k, |best, j| if drop(j) > drop(best) { j } else { best });
+    Some(k)
 }
