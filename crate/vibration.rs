@@ -341,7 +341,7 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
     // V oscillates in f with period ~1/duration; sample it at least 40 times per period, but
     // spend at most MAX_SCAN_WORK impulse-evaluations per side (coarser beyond that).
     let per_period = 1.0 / (40.0 * shaper.duration().max(f64::MIN_POSITIVE));
-    let work_step = |span: f64| span * shaper.len() as f64 / MAX_SCAN_WORK;
+    let work_step = |span: f64| span * shaper.factor_impulses() as f64 / MAX_SCAN_WORK;
     let mut values = Vec::with_capacity(SCAN_CHUNK);
     let mut edge = |direction: f64, limit: f64| -> f64 {
         let span = (limit - f_m).abs();
