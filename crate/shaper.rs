@@ -239,6 +239,16 @@ impl Shaper {
         self.factors().map(<[Impulse]>::len).sum()
     }
 
+    /// Impulses of the expanded shaper without forming them: [`Shaper::len`], or for a
+    /// factored shaper the product Π nₖ of its factors' counts (an upper bound: merging
+    /// coincident products can only lower it).
+    pub fn expanded_len(&self) -> usize {
+        if self.factored {
+            return self.factors.iter().map(Vec::len).product();
+        }
+        self.len()
+    }
+
     /// Always false: a shaper has at least one impulse.
     pub fn is_empty(&self) -> bool {
         false
