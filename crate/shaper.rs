@@ -366,7 +366,7 @@ impl Shaper {
             return Ok(factors
                 .into_iter()
                 .next()
-                .map_or_else(Shaper::identity, |f| Shaper::from_impulses(f)));
+                .map_or_else(Shaper::identity, Shaper::from_impulses));
         }
         Shaper::factored(factors)
     }
@@ -378,7 +378,7 @@ impl Shaper {
             .iter()
             .map(|f| f.iter().map(|imp| imp.amplitude.abs()).sum::<f64>())
             .product();
-        if !(bound <= MAX_AMPLITUDE) {
+        if bound.is_nan() || bound > MAX_AMPLITUDE {
             return Err(Error::invalid(
                 "impulses",
                 format!(

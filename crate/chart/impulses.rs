@@ -111,7 +111,7 @@ fn drawn_impulses(impulses: &[Impulse]) -> (Vec<Impulse>, bool) {
         let k = ((imp.time / end * (ENVELOPE_BINS - 1) as f64) as usize).min(ENVELOPE_BINS - 1);
         let side = usize::from(imp.amplitude < 0.0);
         let slot = &mut bins[k][side];
-        if slot.map_or(true, |s| imp.amplitude.abs() > s.amplitude.abs()) {
+        if slot.is_none_or(|s| imp.amplitude.abs() > s.amplitude.abs()) {
             *slot = Some(*imp);
         }
     }
