@@ -13,7 +13,7 @@ pub const MAX_IMPULSES: usize = 4096;
 /// Most impulses a convolution may stand for (the product of its factors' counts). Beyond
 /// [`MAX_IMPULSES`] a convolution stays factored: it is analysed and simulated from its factors
 /// (Σ nₖ impulses), and its impulse list is formed only when asked for ([`Shaper::impulses`]:
-/// the impulse table, exports), once. 4⁸ = 5⁶·4 …: ZV-D³ over six modes (5⁶ = 15 625) fits.
+/// the impulse table, exports), once. ZV-D³ over six modes (5⁶ = 15 625) fits.
 pub const MAX_CONVOLVED_IMPULSES: usize = 1 << 16;
 /// Largest |amplitude| accepted. Shapers' amplitudes are fractions of the command (±2 for
 /// bang-bang); beyond this, sums of a few thousand impulses and V itself could overflow f64.
