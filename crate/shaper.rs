@@ -6,9 +6,15 @@
 
 use crate::error::{finite, Error, Result};
 use serde::{Deserialize, Serialize};
+use std::sync::OnceLock;
 
 /// Most impulses a shaper may hold (keeps memory and every evaluation bounded).
 pub const MAX_IMPULSES: usize = 4096;
+/// Most impulses a convolution may stand for (the product of its factors' counts). Beyond
+/// [`MAX_IMPULSES`] a convolution stays factored: it is analysed and simulated from its factors
+/// (Σ nₖ impulses), and its impulse list is formed only when asked for ([`Shaper::impulses`]:
+/// the impulse table, exports), once. ZV-D³ over six modes (5⁶ = 15 625) fits.
+pub const MAX_CONVOLVED_IMPULSES: usize = 1 << 16;
 /// Largest |amplitude| accepted. Shapers' amplitudes are fractions of the command (±2 for
 /// bang-bang); beyond this, sums of a few thousand impulses and V itself could overflow f64.
 pub const MAX_AMPLITUDE: f64 = 1e12;
@@ -33,17 +39,26 @@ pub struct Impulse {
 /// V(ω, ζ) of the product is the product of the factors' V, and the analyses
 /// ([`crate::vibration`]) evaluate Σ nₖ impulses instead of Π nₖ. Two shapers are equal when
 /// their impulses are; the factors are not part of the value.
+///
+/// A convolution of more than [`MAX_IMPULSES`] impulses (up to [`MAX_CONVOLVED_IMPULSES`]) is
+/// *factored*: its impulses are formed from the factors the first time [`Shaper::impulses`] is
+/// called, and its duration, amplitude sum and centroid come from the factors (the duration of
+/// a convolution is the sum of the factors' durations, its amplitude sum the product of theirs,
+/// its centroid the sum of theirs).
 #[derive(Debug, Clone)]
 pub struct Shaper {
-    impulses: Vec<Impulse>,
+    /// The impulses; for a factored shaper formed from `factors` when first asked for.
+    impulses: OnceLock<Vec<Impulse>>,
     /// The convolution factors' impulses (each a valid shaper's), or empty when the shaper is
     /// evaluated from its own impulses.
     factors: Vec<Vec<Impulse>>,
+    /// Whether the shaper is factored (see [`Shaper`]): its summaries come from `factors`.
+    factored: bool,
 }
 
 impl PartialEq for Shaper {
     fn eq(&self, other: &Self) -> bool {
-        self.impulses == other.impulses
+        self.impulses() == other.impulses()
     }
 }
 
@@ -65,6 +80,52 @@ fn is_unit(impulses: &[Impulse]) -> bool {
 
 /// Impulses closer than this (relative to the shaper's duration) are merged into one.
 const MERGE_TOLERANCE: f64 = 1e-12;
+
+/// Sorts `impulses`, merges those at the same time (within [`MERGE_TOLERANCE`] of the span),
+/// drops those of zero amplitude and shifts the first to t = 0. Errors: a merged amplitude
+/// beyond [`MAX_AMPLITUDE`], or amplitudes that cancel to zero.
+fn merge(impulses: Vec<Impulse>) -> Result<Vec<Impulse>> {
+    let mut sorted = impulses;
+    crate::sort::sort_by(&mut sorted, |a, b| a.time.total_cmp(&b.time));
+    let t0 = sorted[0].time;
+    let span = sorted[sorted.len() - 1].time - t0;
+    let tol = MERGE_TOLERANCE * span.max(f64::MIN_POSITIVE);
+    let mut merged: Vec<Impulse> = Vec::with_capacity(sorted.len());
+    for imp in sorted {
+        let t = imp.time - t0;
+        match merged.last_mut() {
+            Some(last) if (t - last.time).abs() <= tol => last.amplitude += imp.amplitude,
+            _ => merged.push(Impulse {
+                time: t,
+                amplitude: imp.amplitude,
+            }),
+        }
+    }
+    // Amplitudes near f64::MAX can overflow when merged (or when a convolution or
+    // normalisation produced them): refuse rather than return an infinite impulse.
+    if let Some(k) = merged
+        .iter()
+        .position(|imp| imp.amplitude.is_nan() || imp.amplitude.abs() > MAX_AMPLITUDE)
+    {
+        return Err(Error::invalid(
+            format!("impulses[{k}].amplitude"),
+            format!(
+                "combining impulses at the same time gives an amplitude beyond \
+                 {MAX_AMPLITUDE:e}"
+            ),
+        ));
+    }
+    merged.retain(|imp| imp.amplitude != 0.0);
+    if merged.is_empty() {
+        return Err(Error::invalid("impulses", "the amplitudes cancel to zero"));
+    }
+    // Keep the first impulse at exactly t = 0 after dropping cancelled ones.
+    let first = merged[0].time;
+    for imp in &mut merged {
+        imp.time -= first;
+    }
+    Ok(merged)
+}
 
 impl Shaper {
     /// Builds a shaper from impulses in any order. Impulses at the same time are merged, the
@@ -120,49 +181,16 @@ impl Shaper {
         if impulses.iter().all(|imp| imp.amplitude == 0.0) {
             return Err(Error::invalid("impulses", "all amplitudes are zero"));
         }
-        let mut sorted = impulses;
-        crate::sort::sort_by(&mut sorted, |a, b| a.time.total_cmp(&b.time));
-        let t0 = sorted[0].time;
-        let span = sorted[sorted.len() - 1].time - t0;
-        let tol = MERGE_TOLERANCE * span.max(f64::MIN_POSITIVE);
-        let mut merged: Vec<Impulse> = Vec::with_capacity(sorted.len());
-        for imp in sorted {
-            let t = imp.time - t0;
-            match merged.last_mut() {
-                Some(last) if (t - last.time).abs() <= tol => last.amplitude += imp.amplitude,
-                _ => merged.push(Impulse {
-                    time: t,
-                    amplitude: imp.amplitude,
-                }),
-            }
-        }
-        // Amplitudes near f64::MAX can overflow when merged (or when a convolution or
-        // normalisation produced them): refuse rather than return an infinite impulse.
-        if let Some(k) = merged
-            .iter()
-            .position(|imp| imp.amplitude.is_nan() || imp.amplitude.abs() > MAX_AMPLITUDE)
-        {
-            return Err(Error::invalid(
-                format!("impulses[{k}].amplitude"),
-                format!(
-                    "combining impulses at the same time gives an amplitude beyond \
-                     {MAX_AMPLITUDE:e}"
-                ),
-            ));
-        }
-        merged.retain(|imp| imp.amplitude != 0.0);
-        if merged.is_empty() {
-            return Err(Error::invalid("impulses", "the amplitudes cancel to zero"));
-        }
-        // Keep the first impulse at exactly t = 0 after dropping cancelled ones.
-        let first = merged[0].time;
-        for imp in &mut merged {
-            imp.time -= first;
-        }
-        Ok(Shaper {
-            impulses: merged,
+        Ok(Shaper::from_impulses(merge(impulses)?))
+    }
+
+    /// A shaper of already merged impulses.
+    fn from_impulses(impulses: Vec<Impulse>) -> Shaper {
+        Shaper {
+            impulses: OnceLock::from(impulses),
             factors: Vec::new(),
-        })
+            factored: false,
+        }
     }
 
     /// Builds a shaper from its wire form.
@@ -173,78 +201,131 @@ impl Shaper {
     /// The wire form, with the duration filled in.
     pub fn to_data(&self) -> ShaperData {
         ShaperData {
-            impulses: self.impulses.clone(),
+            impulses: self.impulses().to_vec(),
             duration: self.duration(),
         }
     }
 
     /// The identity shaper: one unit impulse at t = 0 (the unshaped command).
     pub fn identity() -> Self {
-        Shaper {
-            impulses: vec![Impulse {
-                time: 0.0,
-                amplitude: 1.0,
-            }],
-            factors: Vec::new(),
-        }
+        Shaper::from_impulses(vec![Impulse {
+            time: 0.0,
+            amplitude: 1.0,
+        }])
     }
 
-    /// The impulses, sorted by time, the first at t = 0.
+    /// The impulses, sorted by time, the first at t = 0. For a factored shaper (see
+    /// [`Shaper`]) they are formed from the factors on the first call (up to
+    /// [`MAX_CONVOLVED_IMPULSES`] products, merged as [`Shaper::new`] merges), then kept.
     pub fn impulses(&self) -> &[Impulse] {
-        &self.impulses
+        self.impulses.get_or_init(|| expand(&self.factors))
     }
 
-    /// Number of impulses.
+    /// Whether the shaper is a convolution kept factored past [`MAX_IMPULSES`] (see
+    /// [`Shaper`]): its impulses are formed only when [`Shaper::impulses`] is called.
+    pub fn is_factored(&self) -> bool {
+        self.factored
+    }
+
+    /// Number of impulses (for a factored shaper, this forms them: see
+    /// [`Shaper::impulses`]; [`Shaper::factor_impulses`] counts without forming them).
     pub fn len(&self) -> usize {
-        self.impulses.len()
+        self.impulses().len()
+    }
+
+    /// Impulses an evaluation walks: the factors' impulses summed (Σ nₖ), or the shaper's own
+    /// count when it has no factors. Bounds the analyses' work ([`crate::vibration`]).
+    pub fn factor_impulses(&self) -> usize {
+        self.factors().map(<[Impulse]>::len).sum()
+    }
+
+    /// Impulses of the expanded shaper without forming them: [`Shaper::len`], or for a
+    /// factored shaper the product Π nₖ of its factors' counts (an upper bound: merging
+    /// coincident products can only lower it).
+    pub fn expanded_len(&self) -> usize {
+        if self.factored {
+            return self.factors.iter().map(Vec::len).product();
+        }
+        self.len()
     }
 
     /// Always false: a shaper has at least one impulse.
     pub fn is_empty(&self) -> bool {
-        self.impulses.is_empty()
+        false
     }
 
-    /// Time of the last impulse, in seconds: the delay the shaper adds to a move.
+    /// Time of the last impulse, in seconds: the delay the shaper adds to a move. For a
+    /// factored shaper the sum of the factors' durations (the first and last products are the
+    /// only ones at their times, so they are neither merged nor cancelled).
     pub fn duration(&self) -> f64 {
-        self.impulses.last().map_or(0.0, |imp| imp.time)
+        if self.factored {
+            return self.factors.iter().map(|f| last_time(f)).sum();
+        }
+        last_time(self.impulses())
     }
 
-    /// Sum of the amplitudes (1 for a shaper that keeps the command's final value).
+    /// Sum of the amplitudes (1 for a shaper that keeps the command's final value). For a
+    /// factored shaper the product of the factors' sums.
     pub fn amplitude_sum(&self) -> f64 {
-        self.impulses.iter().map(|imp| imp.amplitude).sum()
+        if self.factored {
+            return self.factors.iter().map(|f| sum_of(f)).product();
+        }
+        sum_of(self.impulses())
     }
 
     /// Centroid delay Σ Aᵢtᵢ / Σ Aᵢ in seconds: the delay a slow ramp sees through the shaper
     /// (Kamel et al. eq. 10 without the plant's own 2ζ/ω). `None` when the amplitudes sum to 0,
-    /// or when the sums overflow (amplitudes near f64::MAX).
+    /// or when the sums overflow (amplitudes near f64::MAX). For a factored shaper the sum of
+    /// the factors' centroids (the first moment of a convolution is the sum of the factors'
+    /// normalised first moments times the product of their sums).
     pub fn centroid_delay(&self) -> Option<f64> {
-        let sum = self.amplitude_sum();
-        if sum.abs() < 1e-15 {
-            return None;
+        if self.factored {
+            if self.amplitude_sum().abs() < 1e-15 {
+                return None;
+            }
+            return self
+                .factors
+                .iter()
+                .map(|f| centroid_of(f))
+                .sum::<Option<f64>>()
+                .filter(|d| d.is_finite());
         }
-        let delay = self
-            .impulses
-            .iter()
-            .map(|imp| imp.amplitude * imp.time)
-            .sum::<f64>()
-            / sum;
-        delay.is_finite().then_some(delay)
+        centroid_of(self.impulses())
     }
 
     /// The convolution of two shapers: every pair of impulses multiplied, times added.
-    /// Suppresses what either suppresses (Singer & Seering 1988 §2.3).
+    /// Suppresses what either suppresses (Singer & Seering 1988 §2.3). Up to [`MAX_IMPULSES`]
+    /// products the impulses are formed now; beyond, up to [`MAX_CONVOLVED_IMPULSES`], the
+    /// result is factored (see [`Shaper`]). Errors: more products than
+    /// [`MAX_CONVOLVED_IMPULSES`], or, for a factored result, amplitudes that could overflow
+    /// when merged (Π Σ|aᵢ| beyond [`MAX_AMPLITUDE`]).
     pub fn convolve(&self, other: &Shaper) -> Result<Shaper> {
-        let n = self.len() * other.len();
-        if n > MAX_IMPULSES {
+        // V of the product is the product of the factors' V (the transform of a convolution is
+        // the product of the transforms; merging coincident impulses and dropping cancelled
+        // ones change neither).
+        let factors: Vec<Vec<Impulse>> = self
+            .factors()
+            .chain(other.factors())
+            .filter(|f| !is_unit(f))
+            .map(<[Impulse]>::to_vec)
+            .collect();
+        let n = factors
+            .iter()
+            .try_fold(1_usize, |n, f| n.checked_mul(f.len()))
+            .unwrap_or(usize::MAX);
+        if n > MAX_CONVOLVED_IMPULSES {
             return Err(Error::TooLarge {
                 field: "impulses".into(),
                 value: n as f64,
-                limit: MAX_IMPULSES as f64,
+                limit: MAX_CONVOLVED_IMPULSES as f64,
             });
         }
-        let mut out = Vec::with_capacity(n);
-        for a in &self.impulses {
-            for b in &other.impulses {
+        if n > MAX_IMPULSES {
+            return Shaper::factored(factors);
+        }
+        let mut out = Vec::with_capacity(self.len() * other.len());
+        for a in self.impulses() {
+            for b in other.impulses() {
                 out.push(Impulse {
                     time: a.time + b.time,
                     amplitude: a.amplitude * b.amplitude,
@@ -252,25 +333,71 @@ impl Shaper {
             }
         }
         let mut shaper = Shaper::new(out)?;
-        // V of the product is the product of the factors' V (the transform of a convolution is
-        // the product of the transforms; merging coincident impulses and dropping cancelled
-        // ones change neither). Keep the factors when evaluating them is cheaper.
-        let factors: Vec<Vec<Impulse>> = self
-            .factors()
-            .chain(other.factors())
-            .filter(|f| !is_unit(f))
-            .map(<[Impulse]>::to_vec)
-            .collect();
+        // Keep the factors when evaluating them is cheaper.
         if factors.len() > 1 && factors.iter().map(Vec::len).sum::<usize>() < shaper.len() {
             shaper.factors = factors;
         }
         Ok(shaper)
     }
 
+    /// The convolution of two shapers kept factored (see [`Shaper`]) whatever its size, up to
+    /// [`MAX_CONVOLVED_IMPULSES`] products: the same shaper as [`Shaper::convolve`] (the same
+    /// impulses once formed), analysed from its factors. Errors as [`Shaper::convolve`]'s.
+    pub fn convolve_factored(&self, other: &Shaper) -> Result<Shaper> {
+        let factors: Vec<Vec<Impulse>> = self
+            .factors()
+            .chain(other.factors())
+            .filter(|f| !is_unit(f))
+            .map(<[Impulse]>::to_vec)
+            .collect();
+        let n = factors
+            .iter()
+            .try_fold(1_usize, |n, f| n.checked_mul(f.len()))
+            .unwrap_or(usize::MAX);
+        if n > MAX_CONVOLVED_IMPULSES {
+            return Err(Error::TooLarge {
+                field: "impulses".into(),
+                value: n as f64,
+                limit: MAX_CONVOLVED_IMPULSES as f64,
+            });
+        }
+        if factors.len() < 2 {
+            // A single factor (the other was the identity) is that shaper.
+            return Ok(factors
+                .into_iter()
+                .next()
+                .map_or_else(Shaper::identity, Shaper::from_impulses));
+        }
+        Shaper::factored(factors)
+    }
+
+    /// A factored shaper of `factors` (each a valid shaper's impulses, at most
+    /// [`MAX_CONVOLVED_IMPULSES`] products): refused when the merged amplitudes could overflow.
+    fn factored(factors: Vec<Vec<Impulse>>) -> Result<Shaper> {
+        let bound: f64 = factors
+            .iter()
+            .map(|f| f.iter().map(|imp| imp.amplitude.abs()).sum::<f64>())
+            .product();
+        if bound.is_nan() || bound > MAX_AMPLITUDE {
+            return Err(Error::invalid(
+                "impulses",
+                format!(
+                    "the convolution's amplitudes could exceed {MAX_AMPLITUDE:e} \
+                     (the product of the factors' Σ|amplitude| is {bound:e})"
+                ),
+            ));
+        }
+        Ok(Shaper {
+            impulses: OnceLock::new(),
+            factors,
+            factored: true,
+        })
+    }
+
     /// The impulse sequences whose residual vibrations multiply to this shaper's: its
     /// convolution factors (see [`Shaper`]), or its own impulses alone.
     pub fn factors(&self) -> impl Iterator<Item = &[Impulse]> {
-        let own = self.factors.is_empty().then_some(self.impulses.as_slice());
+        let own = self.factors.is_empty().then(|| self.impulses());
         own.into_iter()
             .chain(self.factors.iter().map(Vec::as_slice))
     }
@@ -279,8 +406,22 @@ impl Shaper {
     /// frequency f, scaled by f/f', suits frequency f' when ζ = 0.
     pub fn scaled_in_time(&self, factor: f64) -> Result<Shaper> {
         crate::error::positive("factor", factor)?;
+        if self.factored {
+            let mut scaled = self.factors.iter().map(|f| {
+                Shaper::new(
+                    f.iter()
+                        .map(|imp| Impulse {
+                            time: imp.time * factor,
+                            amplitude: imp.amplitude,
+                        })
+                        .collect(),
+                )
+            });
+            let first = scaled.next().unwrap_or_else(|| Ok(Shaper::identity()))?;
+            return scaled.try_fold(first, |acc, f| acc.convolve(&f?));
+        }
         Shaper::new(
-            self.impulses
+            self.impulses()
                 .iter()
                 .map(|imp| Impulse {
                     time: imp.time * factor,
@@ -299,8 +440,16 @@ impl Shaper {
                 "the amplitudes sum to zero; the shaper cannot be normalised",
             ));
         }
+        if self.factored {
+            let mut parts = self
+                .factors
+                .iter()
+                .map(|f| Shaper::new(f.clone())?.normalized());
+            let first = parts.next().unwrap_or_else(|| Ok(Shaper::identity()))?;
+            return parts.try_fold(first, |acc, f| acc.convolve(&f?));
+        }
         Shaper::new(
-            self.impulses
+            self.impulses()
                 .iter()
                 .map(|imp| Impulse {
                     time: imp.time,
@@ -309,4 +458,55 @@ impl Shaper {
                 .collect(),
         )
     }
+}
+
+/// The time of the last impulse (0 for none).
+fn last_time(impulses: &[Impulse]) -> f64 {
+    impulses.last().map_or(0.0, |imp| imp.time)
+}
+
+/// Σ Aᵢ.
+fn sum_of(impulses: &[Impulse]) -> f64 {
+    impulses.iter().map(|imp| imp.amplitude).sum()
+}
+
+/// Σ Aᵢtᵢ / Σ Aᵢ, `None` when the sum is (near) zero or the result not finite.
+fn centroid_of(impulses: &[Impulse]) -> Option<f64> {
+    let sum = sum_of(impulses);
+    if sum.abs() < 1e-15 {
+        return None;
+    }
+    let delay = impulses
+        .iter()
+        .map(|imp| imp.amplitude * imp.time)
+        .sum::<f64>()
+        / sum;
+    delay.is_finite().then_some(delay)
+}
+
+/// The impulses of the convolution of `factors`: every product, merged as [`Shaper::new`]
+/// merges. A factored shaper was checked when made so that merging cannot overflow; should it
+/// still fail (amplitudes that cancel exactly), the unmerged products are returned rather than
+/// nothing.
+fn expand(factors: &[Vec<Impulse>]) -> Vec<Impulse> {
+    let mut out = vec![Impulse {
+        time: 0.0,
+        amplitude: 1.0,
+    }];
+    for f in factors {
+        let mut next = Vec::with_capacity(out.len() * f.len());
+        for a in &out {
+            for b in f {
+                next.push(Impulse {
+                    time: a.time + b.time,
+                    amplitude: a.amplitude * b.amplitude,
+                });
+            }
+        }
+        out = next;
+    }
+    merge(out.clone()).unwrap_or_else(|_| {
+        crate::sort::sort_by(&mut out, |a, b| a.time.total_cmp(&b.time));
+        out
+    })
 }

@@ -111,8 +111,19 @@ pub fn max_accel(shaper: &Shaper, scv: f64) -> Result<f64> {
         in_range("scv", scv)?;
         return Ok(f64::INFINITY);
     }
-    let ok =
-        |a: f64| -> Result<bool> { Ok(smoothing(shaper, a, scv)? <= KLIPPER_TARGET_SMOOTHING) };
+    // Smoothing is linear in the acceleration on each side of the centroid (see
+    // [`smoothing`]): three sums over the impulses, formed once, serve every step of the
+    // bisection (~60), where each step walked the impulses (15 625 for ZV-D³ over six modes).
+    let moments = Moments::of(shaper, scv)?;
+    let ok = |a: f64| -> Result<bool> {
+        let s = moments.smoothing(a);
+        if s.is_finite() {
+            Ok(s <= KLIPPER_TARGET_SMOOTHING)
+        } else {
+            // The same error as `smoothing` gives.
+            Ok(smoothing(shaper, a, scv)? <= KLIPPER_TARGET_SMOOTHING)
+        }
+    };
     if !ok(1e-9)? {
         return Ok(0.0);
     }
@@ -143,6 +154,52 @@ pub fn max_accel(shaper: &Shaper, scv: f64) -> Result<f64> {
         steps += 1;
     }
     Ok(left)
+}
+
+/// [`smoothing`]'s sums with the acceleration factored out: with dt = t − t_s,
+/// o90 = scv·Σ_{t≥t_s} A dt + a/2·Σ_{t≥t_s} A dt², o180 = a/2·Σ A dt².
+struct Moments {
+    sum: f64,
+    scv: f64,
+    late1: f64,
+    late2: f64,
+    all2: f64,
+}
+
+impl Moments {
+    fn of(shaper: &Shaper, scv: f64) -> Result<Self> {
+        in_range("scv", scv)?;
+        let sum = shaper.amplitude_sum();
+        let ts = shaper.centroid_delay().ok_or_else(|| {
+            Error::invalid(
+                "impulses",
+                "the amplitudes sum to zero; smoothing is undefined",
+            )
+        })?;
+        let (mut late1, mut late2, mut all2) = (0.0, 0.0, 0.0);
+        for imp in shaper.impulses() {
+            let dt = imp.time - ts;
+            if imp.time >= ts {
+                late1 += imp.amplitude * dt;
+                late2 += imp.amplitude * dt * dt;
+            }
+            all2 += imp.amplitude * dt * dt;
+        }
+        Ok(Moments {
+            sum,
+            scv,
+            late1,
+            late2,
+            all2,
+        })
+    }
+
+    /// [`smoothing`] at acceleration `a` (the same number to rounding).
+    fn smoothing(&self, a: f64) -> f64 {
+        let half = 0.5 * a;
+        let o90 = self.scv * self.late1 + half * self.late2;
+        (o90 * std::f64::consts::SQRT_2 / self.sum).max(half * self.all2 / self.sum)
+    }
 }
 
 /// Both figures at Klipper's defaults (accel 5000 mm/s² for smoothing), with `scv` in mm/s.

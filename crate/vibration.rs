@@ -339,9 +339,14 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
         });
     }
     // V oscillates in f with period ~1/duration; sample it at least 40 times per period, but
-    // spend at most MAX_SCAN_WORK impulse-evaluations per side (coarser beyond that).
+    // spend at most MAX_SCAN_WORK impulse-evaluations per side (coarser beyond that). The
+    // impulses counted are the expanded shaper's (Π nₖ for a factored one), as before
+    // shapers were kept factored, though a convolution is evaluated from its Σ nₖ factor
+    // impulses: counting those instead (a finer step, the same work bound) made I(Vtol) at
+    // issue 24's six modes take 70 ms for ZVDD and 87 ms for ZV-D³ natively (2026-12-04,
+    // docs/page-performance.md), the bands of modes 2 … 6 reaching their 50 × f limits.
     let per_period = 1.0 / (40.0 * shaper.duration().max(f64::MIN_POSITIVE));
-    let work_step = |span: f64| span * shaper.len() as f64 / MAX_SCAN_WORK;
+    let work_step = |span: f64| span * shaper.expanded_len() as f64 / MAX_SCAN_WORK;
     let mut values = Vec::with_capacity(SCAN_CHUNK);
     let mut edge = |direction: f64, limit: f64| -> f64 {
         let span = (limit - f_m).abs();

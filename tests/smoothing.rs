@@ -63,3 +63,35 @@ fn degenerate_shapers() {
         Some("scv")
     );
 }
+
+#[test]
+fn max_accel_of_six_mode_convolutions_is_where_smoothing_reaches_0_12() {
+    // The bisection's smoothing from three sums (max_accel) against `smoothing`, which walks
+    // the impulses at each acceleration (15 625 of them for ZV-D³ over six modes).
+    use input_shaping::design::design_for;
+    use input_shaping::ShaperSpec;
+    let modes: Vec<Mode> = [1.2, 3.4, 7.9, 13.0, 21.0, 34.0]
+        .iter()
+        .map(|&f| Mode::new(f, 0.02).unwrap())
+        .collect();
+    // At scv 5 mm/s these shapers (0.5 … 2 s long) smooth by more than 0.12 mm at any
+    // acceleration (max_accel 0); at scv 0 smoothing is proportional to it, so the bisection runs.
+    for spec in [
+        ShaperSpec::Zv,
+        ShaperSpec::Zvdd,
+        ShaperSpec::Zvdn { derivatives: 3 },
+    ] {
+        let s = design_for(&spec, &modes).unwrap();
+        assert_eq!(max_accel(&s, 5.0).unwrap(), 0.0);
+        assert!(smoothing(&s, 1e-9, 5.0).unwrap() > 0.12);
+        let a = max_accel(&s, 0.0).unwrap();
+        assert!(a > 0.0 && a.is_finite(), "{spec:?}: {a}");
+        let at = smoothing(&s, a, 0.0).unwrap();
+        let beyond = smoothing(&s, a * (1.0 + 1e-6), 0.0).unwrap();
+        assert!(
+            at <= 0.12 + 1e-12 && (at - 0.12).abs() < 1e-9,
+            "{spec:?}: {at}"
+        );
+        assert!(beyond > 0.12, "{spec:?}: {beyond}");
+    }
+}

@@ -2,7 +2,7 @@
 
 use super::{render_error, ChartStyle, Key, Legend};
 use crate::error::Result;
-use crate::shaper::Shaper;
+use crate::shaper::{Impulse, Shaper};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -52,8 +52,9 @@ pub fn draw_impulses<DB: DrawingBackend>(
             0.0
         };
         let stroke = color.stroke_width(style.px(2.5));
+        let (drawn, every) = drawn_impulses(shaper.impulses());
         chart
-            .draw_series(shaper.impulses().iter().map(|imp| {
+            .draw_series(drawn.iter().map(|imp| {
                 PathElement::new(
                     vec![
                         (imp.time.min(t_max) + dx, 0.0),
@@ -68,8 +69,10 @@ pub fn draw_impulses<DB: DrawingBackend>(
             .map_err(render_error)?;
         keys.push(label.to_string(), Key::line(color.stroke_width(3)));
         let r = style.px(4.0);
+        // A decimated sequence's stems touch: its heads would be a solid band, so left out.
+        let heads = if every { drawn.as_slice() } else { &[] };
         chart
-            .draw_series(shaper.impulses().iter().map(|imp| {
+            .draw_series(heads.iter().map(|imp| {
                 let at = (
                     imp.time.min(t_max) + dx,
                     super::clip(imp.amplitude, a_min, a_max),
@@ -83,4 +86,68 @@ pub fn draw_impulses<DB: DrawingBackend>(
     }
     area.present().map_err(render_error)?;
     Ok(())
+}
+
+/// Most impulses drawn one by one; a longer sequence (a convolution over many modes, up to
+/// 5⁶ = 15 625 impulses) is drawn as its envelope at [`ENVELOPE_BINS`] times.
+const MAX_DRAWN_IMPULSES: usize = 1024;
+/// Time bins of a long sequence's envelope: more than a chart has pixel columns.
+const ENVELOPE_BINS: usize = 2048;
+
+/// The impulses to draw and whether they are all of them: up to [`MAX_DRAWN_IMPULSES`], every
+/// impulse; beyond, per time bin (of [`ENVELOPE_BINS`] over the duration) the largest positive
+/// and the most negative impulse, which at a chart's resolution (fewer pixel columns than
+/// bins) draw the same stems.
+fn drawn_impulses(impulses: &[Impulse]) -> (Vec<Impulse>, bool) {
+    if impulses.len() <= MAX_DRAWN_IMPULSES {
+        return (impulses.to_vec(), true);
+    }
+    let end = impulses
+        .last()
+        .map_or(0.0, |imp| imp.time)
+        .max(f64::MIN_POSITIVE);
+    let mut bins: Vec<[Option<Impulse>; 2]> = vec![[None, None]; ENVELOPE_BINS];
+    for imp in impulses {
+        let k = ((imp.time / end * (ENVELOPE_BINS - 1) as f64) as usize).min(ENVELOPE_BINS - 1);
+        let side = usize::from(imp.amplitude < 0.0);
+        let slot = &mut bins[k][side];
+        if slot.is_none_or(|s| imp.amplitude.abs() > s.amplitude.abs()) {
+            *slot = Some(*imp);
+        }
+    }
+    (bins.into_iter().flatten().flatten().collect(), false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_sequence_is_drawn_as_its_envelope() {
+        // 10 000 impulses alternating in sign, amplitude growing with k: every bin's largest
+        // positive and most negative one are kept, and so the sequence's extremes.
+        let imps: Vec<Impulse> = (0..10000)
+            .map(|k| Impulse {
+                time: k as f64 * 1e-3,
+                amplitude: if k % 2 == 0 { 1.0 } else { -1.0 } * (1.0 + k as f64),
+            })
+            .collect();
+        let (drawn, every) = drawn_impulses(&imps);
+        assert!(!every && drawn.len() <= 2 * ENVELOPE_BINS && drawn.len() < imps.len());
+        assert!(drawn.iter().any(|i| i.amplitude == -10000.0));
+        assert!(drawn.iter().any(|i| i.amplitude == 9999.0));
+        // Each kept impulse is the largest of its sign within its bin.
+        let bin =
+            |t: f64| ((t / 9.999 * (ENVELOPE_BINS - 1) as f64) as usize).min(ENVELOPE_BINS - 1);
+        for d in &drawn {
+            let beaten = imps.iter().any(|i| {
+                bin(i.time) == bin(d.time)
+                    && (i.amplitude < 0.0) == (d.amplitude < 0.0)
+                    && i.amplitude.abs() > d.amplitude.abs()
+            });
+            assert!(!beaten, "{d:?}");
+        }
+        let short = &imps[..100];
+        assert_eq!(drawn_impulses(short), (short.to_vec(), true));
+    }
 }

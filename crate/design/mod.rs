@@ -545,11 +545,20 @@ fn verify_zero_moments(shaper: &Shaper, modes: &[Mode], derivatives: u32) -> Res
 }
 
 /// V vanishes at every mode, from the impulses themselves (not the convolution factors the
-/// design used).
+/// design used) — except for a factored shaper (more than [`crate::shaper::MAX_IMPULSES`]
+/// impulses, see [`Shaper`]), whose impulses are formed only when asked for: its V is the
+/// product of its factors' V, each evaluated from that factor's impulses.
 fn verify_zero_at_modes(shaper: &Shaper, modes: &[Mode]) -> Result<()> {
     for (i, mode) in modes.iter().enumerate() {
-        let v =
-            crate::vibration::vibration_rad(shaper.impulses(), mode.omega_rad_s(), mode.damping());
+        let (w, z) = (mode.omega_rad_s(), mode.damping());
+        let v = if shaper.is_factored() {
+            shaper
+                .factors()
+                .map(|f| crate::vibration::vibration_rad(f, w, z))
+                .product()
+        } else {
+            crate::vibration::vibration_rad(shaper.impulses(), w, z)
+        };
         if v.is_nan() || v > ZERO_VIBRATION_TOLERANCE {
             return Err(Error::Infeasible {
                 reason: format!(

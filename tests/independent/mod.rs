@@ -135,7 +135,14 @@ pub fn check_valid(shaper: &Shaper) -> Result<(), String> {
     if imps.is_empty() {
         return Err("no impulses".into());
     }
-    if imps.len() > input_shaping::shaper::MAX_IMPULSES {
+    // A convolution past MAX_IMPULSES stays factored (its list formed lazily), up to
+    // MAX_CONVOLVED_IMPULSES.
+    let limit = if shaper.is_factored() {
+        input_shaping::shaper::MAX_CONVOLVED_IMPULSES
+    } else {
+        input_shaping::shaper::MAX_IMPULSES
+    };
+    if imps.len() > limit {
         return Err(format!("{} impulses", imps.len()));
     }
     if imps[0].time != 0.0 {

@@ -1,0 +1,231 @@
+//! Convolved shapers kept factored (`Shaper::convolve_factored`, and `Shaper::convolve` past
+//! `MAX_IMPULSES`): every analysis computed from the factors against the same analysis of the
+//! expanded shaper where expansion is possible (≤ 4096 impulses), V against the closed form
+//! (the product of the factors' V), and issue 24's six modes with ZV-D³ (5⁶ = 15 625
+//! impulses), which `design` refused before.
+
+mod common;
+
+use common::Rng;
+use input_shaping::command::{Command, CommandSpec};
+use input_shaping::design::design_for;
+use input_shaping::design::zero_vibration::zv_dn;
+use input_shaping::plant::{ModalPlant, Plant};
+use input_shaping::shaper::{MAX_CONVOLVED_IMPULSES, MAX_IMPULSES};
+use input_shaping::simulate::simulate_shaped;
+use input_shaping::vibration::{
+    damping_sensitivity, insensitivity, residual_vibration, sensitivity, vibration_rad,
+    DampingSensitivityOptions, SensitivityOptions,
+};
+use input_shaping::{Impulse, Mode, Shaper, ShaperSpec};
+
+fn six_modes() -> Vec<Mode> {
+    [1.2, 3.4, 7.9, 13.0, 21.0, 34.0]
+        .iter()
+        .map(|&f| Mode::new(f, 0.02).unwrap())
+        .collect()
+}
+
+/// Relative difference, scaled by at least 1.
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs().max(1.0)
+}
+
+/// A random single-mode factor: ZV-Dⁿ (n 0 … 3) at a random mode, or random custom impulses
+/// (negative amplitudes too).
+fn random_factor(rng: &mut Rng) -> Shaper {
+    if rng.uniform() < 0.6 {
+        let mode = Mode::new(0.5 + 40.0 * rng.uniform(), 0.3 * rng.uniform().powi(2)).unwrap();
+        zv_dn(&mode, (4.0 * rng.uniform()) as u32).unwrap()
+    } else {
+        let n = 2 + (4.0 * rng.uniform()) as usize;
+        Shaper::new(
+            (0..n)
+                .map(|_| Impulse {
+                    time: 0.5 * rng.uniform(),
+                    amplitude: rng.uniform() - 0.3,
+                })
+                .collect(),
+        )
+        .unwrap()
+    }
+}
+
+/// The pair (expanded, factored) of the same random convolution of 2 … 4 factors, ≤ 4096
+/// impulses.
+fn random_pair(rng: &mut Rng) -> (Shaper, Shaper) {
+    let k = 2 + (3.0 * rng.uniform()) as usize;
+    let factors: Vec<Shaper> = (0..k).map(|_| random_factor(rng)).collect();
+    let mut expanded = factors[0].clone();
+    let mut factored = factors[0].clone();
+    for f in &factors[1..] {
+        expanded = expanded.convolve(f).unwrap();
+        factored = factored.convolve_factored(f).unwrap();
+    }
+    assert!(!expanded.is_factored() && factored.is_factored());
+    (expanded, factored)
+}
+
+#[test]
+fn factored_analyses_equal_the_expanded_ones() {
+    let mut rng = Rng(24);
+    for _ in 0..40 {
+        let (e, f) = random_pair(&mut rng);
+        // Formed lazily, the impulses are the expanded shaper's.
+        assert_eq!(e.len(), f.len());
+        for (a, b) in e.impulses().iter().zip(f.impulses()) {
+            assert!(rel(a.time, b.time) < 1e-12 && rel(a.amplitude, b.amplitude) < 1e-12);
+        }
+        assert!(rel(f.duration(), e.duration()) < 1e-12);
+        assert!(rel(f.amplitude_sum(), e.amplitude_sum()) < 1e-12);
+        match (f.centroid_delay(), e.centroid_delay()) {
+            (Some(a), Some(b)) => assert!(rel(a, b) < 1e-9, "{a} vs {b}"),
+            (a, b) => assert_eq!(a.is_some(), b.is_some()),
+        }
+        let top = 3.0 / f.duration().max(1e-3) + 20.0;
+        let options = SensitivityOptions {
+            from_hz: 0.0,
+            to_hz: top,
+            points: 400,
+            damping: 0.05,
+        };
+        let (ce, cf) = (
+            sensitivity(&e, &options).unwrap(),
+            sensitivity(&f, &options).unwrap(),
+        );
+        let scale = e.impulses().iter().map(|i| i.amplitude.abs()).sum::<f64>();
+        for (a, b) in ce.vibration.iter().zip(&cf.vibration) {
+            assert!((a - b).abs() < 1e-12 * scale.max(1.0), "V(f): {a} vs {b}");
+        }
+        let d = DampingSensitivityOptions {
+            frequency_hz: 0.3 * top,
+            from_damping: 0.0,
+            to_damping: 0.5,
+            points: 50,
+        };
+        let (de, df) = (
+            damping_sensitivity(&e, &d).unwrap(),
+            damping_sensitivity(&f, &d).unwrap(),
+        );
+        for (a, b) in de.vibration.iter().zip(&df.vibration) {
+            assert!((a - b).abs() < 1e-12 * scale.max(1.0), "V(ζ): {a} vs {b}");
+        }
+    }
+}
+
+#[test]
+fn factored_multi_mode_designs_keep_bands_and_responses() {
+    // Where the design still expands (≤ 4096), the same design kept factored has the same
+    // I(Vtol) bands and the same simulated response.
+    let modes = six_modes();
+    let plant = Plant::Modal(
+        ModalPlant::new(
+            modes
+                .iter()
+                .map(|m| Mode::new(m.frequency_hz() * 1.05, 0.03).unwrap())
+                .collect(),
+            vec![1.0 / 6.0; 6],
+        )
+        .unwrap(),
+    );
+    let command = Command::from_spec(&CommandSpec::Trapezoid {
+        distance: 1.0,
+        max_velocity: 0.75,
+        max_acceleration: 8.0,
+        start: 0.0,
+    })
+    .unwrap();
+    for (n, spec) in [(2, ShaperSpec::Zv), (3, ShaperSpec::Zvd)] {
+        let singles: Vec<Shaper> = modes.iter().map(|m| zv_dn(m, n - 2).unwrap()).collect();
+        let e = design_for(&spec, &modes).unwrap();
+        let f = singles[1..]
+            .iter()
+            .try_fold(singles[0].clone(), |a, s| a.convolve_factored(s))
+            .unwrap();
+        assert!(f.is_factored() && !e.is_factored());
+        assert_eq!(f.factor_impulses(), n as usize * 6);
+        for m in &modes {
+            for vtol in [0.05, 0.1] {
+                let (be, bf) = (
+                    insensitivity(&e, m, vtol).unwrap(),
+                    insensitivity(&f, m, vtol).unwrap(),
+                );
+                // The scan's step depends on the work it counts (fewer terms factored: a
+                // finer or equal step), so an edge agrees to the refinement's tolerance.
+                assert!(
+                    (be.low_hz - bf.low_hz).abs() < 1e-6 * m.frequency_hz()
+                        && (be.high_hz - bf.high_hz).abs() < 1e-6 * m.frequency_hz(),
+                    "{spec:?} at {} Hz: {be:?} vs {bf:?}",
+                    m.frequency_hz()
+                );
+            }
+        }
+        let (te, tf) = (
+            simulate_shaped(&plant, &command, &e, 2e-3, 3.0).unwrap(),
+            simulate_shaped(&plant, &command, &f, 2e-3, 3.0).unwrap(),
+        );
+        for (a, b) in te.endpoint.iter().zip(&tf.endpoint) {
+            assert!((a - b).abs() < 1e-10, "{a} vs {b}");
+        }
+    }
+}
+
+#[test]
+fn six_modes_zv_d3_is_designed_factored() {
+    // 5⁶ = 15 625 impulses: over MAX_IMPULSES, under MAX_CONVOLVED_IMPULSES.
+    let modes = six_modes();
+    let shaper = design_for(&ShaperSpec::Zvdn { derivatives: 3 }, &modes).unwrap();
+    assert!(shaper.is_factored());
+    assert_eq!(shaper.factor_impulses(), 5 * 6);
+    let singles: Vec<Shaper> = modes.iter().map(|m| zv_dn(m, 3).unwrap()).collect();
+    // Closed forms: the duration is the sum of the factors' durations (ZV-D³: 2 damped
+    // periods each), the amplitude sum the product (1), V the product of the factors' V.
+    let periods: f64 = modes.iter().map(|m| 2.0 * m.damped_period_s()).sum();
+    assert!(rel(shaper.duration(), periods) < 1e-12);
+    assert!(rel(shaper.amplitude_sum(), 1.0) < 1e-12);
+    for m in &modes {
+        assert!(residual_vibration(&shaper, m) < 1e-9);
+    }
+    let options = SensitivityOptions {
+        from_hz: 0.0,
+        to_hz: 60.0,
+        points: 301,
+        damping: 0.02,
+    };
+    let curve = sensitivity(&shaper, &options).unwrap();
+    for (f, v) in curve.frequency_hz.iter().zip(&curve.vibration) {
+        let w = 2.0 * std::f64::consts::PI * f;
+        let product: f64 = singles
+            .iter()
+            .map(|s| vibration_rad(s.impulses(), w, 0.02))
+            .product();
+        assert!((v - product).abs() < 1e-12, "at {f} Hz: {v} vs {product}");
+    }
+    // Expanded lazily, once: the impulses' own V is the product to rounding.
+    let impulses = shaper.impulses();
+    assert!(impulses.len() > MAX_IMPULSES && impulses.len() <= MAX_CONVOLVED_IMPULSES);
+    assert!(rel(impulses.last().unwrap().time, periods) < 1e-12);
+    for f in [0.7, 2.0, 5.5, 10.0, 17.0, 27.0, 45.0] {
+        let w = 2.0 * std::f64::consts::PI * f;
+        let product: f64 = singles
+            .iter()
+            .map(|s| vibration_rad(s.impulses(), w, 0.02))
+            .product();
+        assert!((vibration_rad(impulses, w, 0.02) - product).abs() < 1e-9);
+    }
+    // Every band is found, from the factors.
+    for m in &modes {
+        let band = insensitivity(&shaper, m, 0.05).unwrap();
+        assert!(band.low_hz < m.frequency_hz() && m.frequency_hz() < band.high_hz);
+    }
+}
+
+#[test]
+fn a_convolution_past_the_factored_limit_is_refused() {
+    let modes: Vec<Mode> = (0..7)
+        .map(|k| Mode::new(1.0 + 3.0 * k as f64, 0.02).unwrap())
+        .collect();
+    // 5⁷ = 78 125 > MAX_CONVOLVED_IMPULSES.
+    let e = design_for(&ShaperSpec::Zvdn { derivatives: 3 }, &modes).unwrap_err();
+    assert_eq!(e.field(), Some("impulses"));
+}
