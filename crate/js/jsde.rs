@@ -17,6 +17,9 @@ use wasm_bindgen::{JsCast, JsValue};
 
 type Result<T> = std::result::Result<T, Error>;
 
+#[cfg(test)]
+mod differential;
+
 #[wasm_bindgen::prelude::wasm_bindgen]
 extern "C" {
     /// `Object.entries(object)`, its exception caught: a getter or a Proxy trap may throw
@@ -96,9 +99,28 @@ fn note(error: Error) -> Error {
 
 /// Deserializes `value`; on failure, returns the path of the failing field (`.` for the value
 /// itself, as serde_path_to_error prints it) and the error.
-pub(crate) fn deserialize<T: DeserializeOwned>(
+///
+/// `Debug`: in the crate's tests every read is also made by upstream serde-wasm-bindgen with
+/// serde_path_to_error and serde's own tagged-enum parser, and the two compared
+/// ([`differential`]).
+pub(crate) fn deserialize<T: DeserializeOwned + std::fmt::Debug>(
     value: JsValue,
 ) -> std::result::Result<T, (String, Error)> {
+    #[cfg(not(test))]
+    {
+        fork(value)
+    }
+    #[cfg(test)]
+    {
+        let upstream = differential::upstream::<T>(&value);
+        let read = fork::<T>(value.clone());
+        differential::compare(core::any::type_name::<T>(), &value, upstream, &read);
+        read
+    }
+}
+
+/// [`deserialize`] by the fork alone.
+fn fork<T: DeserializeOwned>(value: JsValue) -> std::result::Result<T, (String, Error)> {
     #[cfg(feature = "any-deserializer")]
     crate::tagged::JS_READER.get_or_init(core::any::type_name::<De>);
     PATH.with(|p| p.borrow_mut().clear());
