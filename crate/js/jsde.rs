@@ -101,8 +101,8 @@ fn note(error: Error) -> Error {
 /// itself, as serde_path_to_error prints it) and the error.
 ///
 /// `Debug`: in the crate's tests every read is also made by upstream serde-wasm-bindgen with
-/// serde_path_to_error and serde's own tagged-enum parser, and the two compared
-/// ([`differential`]).
+/// serde_path_to_error and by this reader with serde's own tagged-enum parser, and the three
+/// compared ([`differential`]).
 pub(crate) fn deserialize<T: DeserializeOwned + std::fmt::Debug>(
     value: JsValue,
 ) -> std::result::Result<T, (String, Error)> {
@@ -113,8 +113,15 @@ pub(crate) fn deserialize<T: DeserializeOwned + std::fmt::Debug>(
     #[cfg(test)]
     {
         let upstream = differential::upstream::<T>(&value);
+        let buffered = differential::buffered(|| fork::<T>(value.clone()));
         let read = fork::<T>(value.clone());
-        differential::compare(core::any::type_name::<T>(), &value, upstream, &read);
+        differential::compare(
+            core::any::type_name::<T>(),
+            &value,
+            upstream,
+            buffered,
+            &read,
+        );
         read
     }
 }
