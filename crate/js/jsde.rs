@@ -30,8 +30,13 @@ extern "C" {
 
 /// [`try_entries`], a throw reported as an error of the value.
 fn entries_of(object: &JsValue) -> Result<Array> {
-    try_entries(object)
-        .map_err(|_| de::Error::custom("could not be read (a getter or a Proxy trap threw)"))
+    try_entries(object).map_err(|_| threw())
+}
+
+/// The error of a value whose reading threw.
+#[cold]
+fn threw() -> Error {
+    de::Error::custom("could not be read (a getter or a Proxy trap threw)")
 }
 
 /// One step of the path: an element index, a map key (or enum variant), or a non-string key.
@@ -283,6 +288,14 @@ impl MapAccess {
                 None => return Ok(None),
                 Some(Err(e)) => return Err(fail_at(Segment::Unknown, Error::from(e))),
                 Some(Ok(pair)) => {
+                    // Not `[key, value]`: `null[0]` would throw through the module
+                    // (serde-wasm-bindgen's `convert_pair` lets it: `[null]` read where a
+                    // struct with a flattened part goes, through serde's buffered parser).
+                    if pair.loose_eq(&JsValue::NULL) {
+                        let e =
+                            de::Error::invalid_type(de::Unexpected::Unit, &"a [key, value] pair");
+                        return Err(fail_at(Segment::Unknown, e));
+                    }
                     let (key, value) = convert_pair(pair);
                     self.value = Some(value);
                     key
@@ -571,9 +584,12 @@ impl De {
             self.seq(visitor)
         } else if let Some(bytes) = self.as_bytes() {
             visitor.visit_byte_buf(bytes)
-        } else if self.value.is_object()
-            && (!Symbol::iterator().js_in(&self.value) || self.value.has_type::<Map>())
-        {
+        } else if self.value.is_object() && {
+            // `Symbol.iterator in value`, a Proxy's `has` trap's throw caught.
+            let iterable = js_sys::Reflect::has(&self.value, Symbol::iterator().as_ref())
+                .map_err(|_| threw())?;
+            !iterable || self.value.has_type::<Map>()
+        } {
             self.map(visitor)
         } else {
             self.invalid_type(visitor)
