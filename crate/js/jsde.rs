@@ -314,10 +314,13 @@ impl MapAccess {
                 let mut found = None;
                 for field in fields.by_ref() {
                     let js_field = JsValue::from(JsString::from(*field));
-                    let value = js_sys::Reflect::get(object, &js_field).unwrap_or_default();
+                    // A getter or a Proxy trap that throws: an error of that field (not a
+                    // missing field, nor an exception through the module).
+                    let throws = |_| fail_at(Segment::Key(field.to_string()), threw());
+                    let value = js_sys::Reflect::get(object, &js_field).map_err(throws)?;
                     // `undefined` may be a missing field: check with `in`.
                     let missing = value.is_undefined()
-                        && !js_sys::Reflect::has(object, &js_field).unwrap_or(false);
+                        && !js_sys::Reflect::has(object, &js_field).map_err(throws)?;
                     if !missing {
                         found = Some((*field, value));
                         break;
@@ -599,6 +602,10 @@ impl De {
     fn seq<'de, V: Visitor<'de>>(self, visitor: V) -> Result<V::Value> {
         if let Some(arr) = self.value.dyn_ref::<Array>() {
             visitor.visit_seq(SeqAccess::array(arr.clone()))
+        } else if !self.value.is_object() {
+            // Not asked for its `Symbol.iterator`: `Reflect.get` throws on a number or a string
+            // (serde-wasm-bindgen reports that `TypeError` as the error).
+            self.invalid_type(visitor)
         } else if let Some(iter) = js_sys::try_iter(&self.value)? {
             visitor.visit_seq(SeqAccess::Iter(iter, 0))
         } else {
@@ -607,6 +614,10 @@ impl De {
     }
 
     fn map<'de, V: Visitor<'de>>(self, visitor: V) -> Result<V::Value> {
+        if !self.value.is_object() {
+            // As in `seq`: not a `TypeError` from `Reflect.get` on a primitive.
+            return self.invalid_type(visitor);
+        }
         match js_sys::try_iter(&self.value)? {
             Some(iter) => visitor.visit_map(MapAccess::new(MapSource::Iter(iter))),
             None => {
@@ -670,8 +681,8 @@ impl De {
             return self.invalid_type(visitor);
         }
         let key = JsValue::from_str(field);
-        let tag = js_sys::Reflect::get(&self.value, &key)?;
-        if tag.is_undefined() && !js_sys::Reflect::has(&self.value, &key)? {
+        let tag = js_sys::Reflect::get(&self.value, &key).map_err(|_| threw())?;
+        if tag.is_undefined() && !js_sys::Reflect::has(&self.value, &key).map_err(|_| threw())? {
             return Err(de::Error::missing_field(field));
         }
         visitor.visit_enum(EnumAccess {

@@ -58,9 +58,14 @@ enum Rule {
     /// `[null]` where a struct with a flattened part goes). An exception through wasm skips
     /// Rust's destructors: the boundary must never let one out (issue 21).
     UpstreamThrew,
+    /// Reader: a number, a string or a boolean where a list or a map goes (or a struct with a
+    /// flattened part, which serde reads as a map): upstream asks it for its `Symbol.iterator`
+    /// with `Reflect.get`, which throws on a primitive, and reports that (`TypeError:
+    /// Reflect.get called on non-object`); the fork says `invalid type`.
+    PrimitiveNotIterated,
     /// Reader: a typed array where an externally tagged enum goes: upstream counts its entries
     /// (`invalid length N, expected 1`, `Object.entries` of 2^26 elements for a long signal:
-    /// gigabytes); the fork says `invalid type: binary data`.
+    /// gigabytes); the fork says `invalid type: binary data` (`byte array` for bytes).
     TypedArrayNotEntries,
     /// Tagged: serde's buffer loses the path at the spec and names values as it holds them;
     /// the fork names the field inside (`shapers[0].humps` for `shapers[0]`) and the value as
@@ -79,9 +84,10 @@ enum Rule {
     /// outside a tagged spec.
     BufferedNumbers,
     /// Tagged: from the buffer serde reads a struct from an array by position (`[4, 0.05]` as
-    /// a mode, `invalid length 0, expected struct Impulse with 2 elements`) and bytes
-    /// (`Uint8Array`) as bytes, not a list; the fork reads a struct only from an object's
-    /// fields and a list from any iterable, as upstream does outside a tagged spec.
+    /// a mode, `invalid length 0, expected struct Impulse with 2 elements`), an internally
+    /// tagged enum from an array with its tag first, and bytes (`Uint8Array`) as bytes, not a
+    /// list; the fork reads a struct only from an object's fields and a list from any
+    /// iterable, as upstream does outside a tagged spec.
     BufferedShapes,
     /// Tagged: an externally tagged enum inside a tagged spec (`objective`, `interpolation`):
     /// from the buffer serde wants `string or map` or a `map with a single key`; the fork says
@@ -89,12 +95,25 @@ enum Rule {
     /// type, `unknown variant`).
     BufferedEnumNames,
     /// Tagged: a JS `Map` is not read as a tagged spec (serde's buffer reads any iterable of
-    /// pairs): the fork says the tag is missing.
+    /// pairs): the fork says the tag is missing; inside a spec the buffer holds a `Map` as a
+    /// map, the fork reads it as upstream does outside a spec (a list of `[key, value]` pairs
+    /// where a list goes).
     MapNotSpec,
+    /// Tagged: serde's derive reads a struct with a flattened part (`DesignRequest`,
+    /// `ShaperRequest`, …) as a map of all its entries, so from the buffer an array is a map
+    /// of its elements (`expected field identifier`, `expected a [key, value] pair`, at `?`)
+    /// and a detached or proxied typed array's iterator throws; the fork reads the struct's
+    /// fields from the object (`missing field`, `invalid type`), as for any other struct.
+    FlattenedReadAsMap,
+    /// Tagged: the buffer reads every property of an object (`Object.entries`), the fork only
+    /// the fields it needs: a getter's or a Proxy trap's throw is reported by the buffer
+    /// wherever it is, by the fork where it reads it (or never, when the value is of the wrong
+    /// type before any property is read).
+    BufferReadsEverything,
 }
 
 /// Every rule, each of which the corpus must need.
-const RULES: [Rule; 11] = [
+const RULES: [Rule; 14] = [
     Rule::Identical,
     Rule::DescribedNotPrinted,
     Rule::LongStringCut,
@@ -106,6 +125,9 @@ const RULES: [Rule; 11] = [
     Rule::BufferedShapes,
     Rule::BufferedEnumNames,
     Rule::MapNotSpec,
+    Rule::PrimitiveNotIterated,
+    Rule::FlattenedReadAsMap,
+    Rule::BufferReadsEverything,
 ];
 
 #[derive(Default)]
@@ -320,10 +342,26 @@ fn judge_reader(up: &Outcome, fork: &Outcome) -> Option<Rule> {
                 path: fork_path,
                 message: fork_message,
             },
+        ) if up_path == fork_path
+            && up_message == "TypeError: Reflect.get called on non-object"
+            && fork_message.starts_with("invalid type: ") =>
+        {
+            Some(Rule::PrimitiveNotIterated)
+        }
+        (
+            Failed {
+                path: up_path,
+                message: up_message,
+            },
+            Failed {
+                path: fork_path,
+                message: fork_message,
+            },
         ) if up_path == fork_path => {
             if up_message.starts_with("invalid length ")
                 && up_message.ends_with(", expected 1")
-                && fork_message.starts_with("invalid type: binary data, expected ")
+                && (fork_message.starts_with("invalid type: binary data, expected ")
+                    || fork_message.starts_with("invalid type: byte array, expected "))
             {
                 return Some(Rule::TypedArrayNotEntries);
             }
@@ -349,7 +387,9 @@ fn same_value_named(buf: &str, fork: &str) -> bool {
     buf == fork
         || matches!(
             (buf, fork),
-            ("map", "an object") | ("sequence", "an array") | ("unit value", "null")
+            ("map", "an object" | "binary data")
+                | ("sequence", "an array")
+                | ("unit value", "null")
         )
         || buf
             .strip_prefix("integer `")
@@ -400,6 +440,50 @@ fn judge_tagged(buf: &Outcome, fork: &Outcome, hostile: Option<&str>) -> Option<
                 message: fork_message,
             },
         ) => {
+            let buf_struct = buf_path
+                .strip_suffix(".?")
+                .or_else(|| {
+                    buf_path
+                        .strip_suffix('?')
+                        .map(|p| if p.is_empty() { "." } else { p })
+                })
+                .unwrap_or(buf_path);
+            let throwing = matches!(
+                hostile,
+                Some("throwing getters" | "Proxy with throwing traps")
+            );
+            if (buf_message.starts_with("could not be read (") || throwing)
+                && (above(buf_path, fork_path) || above(fork_path, buf_path))
+            {
+                return Some(Rule::BufferReadsEverything);
+            }
+            let fork_struct = fork_message.starts_with("missing field `")
+                || (fork_message.starts_with("invalid type: ")
+                    && fork_message.contains(", expected struct "));
+            if fork_struct
+                && above(buf_struct, fork_path)
+                && (buf_message == "TypeError: Reflect.get called on non-object"
+                    || buf_message.starts_with("TypeError: Cannot perform %TypedArray%")
+                    || buf_message == "TypeError: this is not a typed array."
+                    || buf_message.ends_with(", expected field identifier")
+                    || buf_message.ends_with(", expected a [key, value] pair"))
+            {
+                return Some(Rule::FlattenedReadAsMap);
+            }
+            if hostile == Some("Map") {
+                return Some(Rule::MapNotSpec);
+            }
+            let is_array = hostile.is_some_and(|h| {
+                h.starts_with('[') || h.starts_with("Array(") || h.contains("Proxy of an array")
+            });
+            if is_array
+                && fork_message.starts_with("missing field `")
+                && (above(buf_path, fork_path) || above(fork_path, buf_path))
+            {
+                // From the buffer an array is a struct by position, an internally tagged
+                // enum's tag its first element.
+                return Some(Rule::BufferedShapes);
+            }
             if !above(buf_path, fork_path) {
                 return None;
             }
@@ -421,8 +505,17 @@ fn judge_tagged(buf: &Outcome, fork: &Outcome, hostile: Option<&str>) -> Option<
             {
                 return Some(Rule::BufferedShapes);
             }
-            if buf_message.starts_with("invalid type: byte array, expected ") {
+            if buf_message.starts_with("invalid type: byte array, expected ")
+                || (buf_message.starts_with("unknown variant `")
+                    && fork_message.starts_with("invalid type: byte array, expected "))
+            {
+                // Bytes from the buffer are bytes, a variant's name among them.
                 return Some(Rule::BufferedShapes);
+            }
+            if buf_message.contains(", expected variant index ")
+                && fork_message.starts_with("invalid type: a BigInt, expected ")
+            {
+                return Some(Rule::BufferedNumbers);
             }
             if hostile == Some("Map") && fork_message.starts_with("missing field `") {
                 return Some(Rule::MapNotSpec);
@@ -584,6 +677,11 @@ mod tests {
         root
     }
 
+    /// Of the hostile values planted inside a value, one in `STRIDE` is fed (the `i`-th
+    /// hostile value at the `j`-th path when `(i + j) % STRIDE == 0`, so each value and each
+    /// path is still fed); every hostile value is fed in place of the whole value.
+    static STRIDE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(1);
+
     /// Feeds `make()`, then each hostile value in its place and at each of its inner paths,
     /// to `read`.
     fn feed_all(
@@ -594,13 +692,17 @@ mod tests {
         feeding(None, || read(make()));
         let mut inner = Vec::new();
         paths(&make(), 3, &mut Vec::new(), &mut inner);
-        for (label, value) in hostile {
+        let stride = STRIDE.load(Ordering::Relaxed);
+        for (i, (label, value)) in hostile.iter().enumerate() {
             let fresh = || value.call0(&JsValue::NULL).unwrap();
             feeding(Some(label), || read(fresh()));
             if HEAVY.contains(&label.as_str()) {
                 continue;
             }
-            for path in &inner {
+            for (j, path) in inner.iter().enumerate() {
+                if (i + j) % stride != 0 {
+                    continue;
+                }
                 let v = planted(make, path, &fresh());
                 feeding(Some(label), || read(v));
             }
@@ -655,10 +757,25 @@ mod tests {
         r#"{"kind":"vecianaTestBed"}"#,
     ];
 
-    /// Every read in the corpus agrees with upstream, or differs only as a rule of [`judge`]
-    /// says; every rule is needed; every spec and options type is read.
     #[wasm_bindgen_test]
-    #[ignore = "unfinished (issue 21 item 4): upstream's read of a hostile value (a Set or Map whose entries are not pairs) throws through wasm-bindgen's debug import wrapper and the Node run exits; the rules are not yet checked against a full run"]
+    #[ignore = "the whole corpus: ~4 min in Node (debug wasm); `cargo test --target wasm32-unknown-unknown --lib -- --include-ignored the_forks_read_the_whole_corpus`"]
+    fn the_forks_read_the_whole_corpus_as_upstream_does() {
+        STRIDE.store(1, Ordering::Relaxed);
+        the_forks_read_the_corpus_as_upstream_does();
+    }
+
+    /// In `npm test`: every value of the corpus and every hostile value in place of each, and
+    /// one in four of the hostile values planted inside them.
+    #[wasm_bindgen_test]
+    #[ignore = "being checked (run of 2026-12-04 in progress)"]
+    fn the_forks_read_a_quarter_of_the_corpus_as_upstream_does() {
+        STRIDE.store(4, Ordering::Relaxed);
+        the_forks_read_the_corpus_as_upstream_does();
+    }
+
+    /// Every read in the corpus agrees with upstream, or differs only as a rule of
+    /// [`judge_reader`] / [`judge_tagged`] says; every rule is needed; every spec and options
+    /// type is read.
     fn the_forks_read_the_corpus_as_upstream_does() {
         use crate::command::CommandSpec;
         use crate::design::DesignRequest;
