@@ -767,7 +767,6 @@ mod tests {
     /// In `npm test`: every value of the corpus and every hostile value in place of each, and
     /// one in four of the hostile values planted inside them.
     #[wasm_bindgen_test]
-    #[ignore = "being checked (run of 2026-12-04 in progress)"]
     fn the_forks_read_a_quarter_of_the_corpus_as_upstream_does() {
         STRIDE.store(4, Ordering::Relaxed);
         the_forks_read_the_corpus_as_upstream_does();
