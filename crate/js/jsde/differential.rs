@@ -415,9 +415,7 @@ fn judge_tagged(buf: &Outcome, fork: &Outcome, hostile: Option<&str>) -> Option<
                 Some(Rule::BufferedNumbers)
             } else if message.starts_with("missing field `") {
                 // An array read as a struct by position (the hostile value is an array).
-                hostile
-                    .is_some_and(|h| h.starts_with('[') || h.contains("Proxy of an array"))
-                    .then_some(Rule::BufferedShapes)
+                is_array(hostile).then_some(Rule::BufferedShapes)
             } else {
                 None
             }
@@ -439,97 +437,118 @@ fn judge_tagged(buf: &Outcome, fork: &Outcome, hostile: Option<&str>) -> Option<
                 path: fork_path,
                 message: fork_message,
             },
-        ) => {
-            let buf_struct = buf_path
-                .strip_suffix(".?")
-                .or_else(|| {
-                    buf_path
-                        .strip_suffix('?')
-                        .map(|p| if p.is_empty() { "." } else { p })
-                })
-                .unwrap_or(buf_path);
-            let throwing = matches!(
-                hostile,
-                Some("throwing getters" | "Proxy with throwing traps")
-            );
-            if (buf_message.starts_with("could not be read (") || throwing)
-                && (above(buf_path, fork_path) || above(fork_path, buf_path))
-            {
-                return Some(Rule::BufferReadsEverything);
-            }
-            let fork_struct = fork_message.starts_with("missing field `")
-                || (fork_message.starts_with("invalid type: ")
-                    && fork_message.contains(", expected struct "));
-            if fork_struct
-                && above(buf_struct, fork_path)
-                && (buf_message == "TypeError: Reflect.get called on non-object"
-                    || buf_message.starts_with("TypeError: Cannot perform %TypedArray%")
-                    || buf_message == "TypeError: this is not a typed array."
-                    || buf_message.ends_with(", expected field identifier")
-                    || buf_message.ends_with(", expected a [key, value] pair"))
-            {
-                return Some(Rule::FlattenedReadAsMap);
-            }
-            if hostile == Some("Map") {
-                return Some(Rule::MapNotSpec);
-            }
-            let is_array = hostile.is_some_and(|h| {
-                h.starts_with('[') || h.starts_with("Array(") || h.contains("Proxy of an array")
-            });
-            if is_array
-                && fork_message.starts_with("missing field `")
-                && (above(buf_path, fork_path) || above(fork_path, buf_path))
-            {
-                // From the buffer an array is a struct by position, an internally tagged
-                // enum's tag its first element.
-                return Some(Rule::BufferedShapes);
-            }
-            if !above(buf_path, fork_path) {
-                return None;
-            }
-            if buf_message == fork_message {
-                return Some(Rule::TaggedPathAndNames);
-            }
-            let buf_split = split(buf_message);
-            if let Some((_, _, expected)) = buf_split {
-                if expected == "any value" || expected.starts_with("internally tagged enum ") {
-                    return Some(Rule::BufferCannotHold);
-                }
-                if expected == "string or map" || expected == "map with a single key" {
-                    return Some(Rule::BufferedEnumNames);
-                }
-            }
-            if buf_message.starts_with("invalid length ")
-                && (buf_message.contains(", expected struct ")
-                    || buf_message.ends_with(" elements in sequence"))
-            {
-                return Some(Rule::BufferedShapes);
-            }
-            if buf_message.starts_with("invalid type: byte array, expected ")
-                || (buf_message.starts_with("unknown variant `")
-                    && fork_message.starts_with("invalid type: byte array, expected "))
-            {
-                // Bytes from the buffer are bytes, a variant's name among them.
-                return Some(Rule::BufferedShapes);
-            }
-            if buf_message.contains(", expected variant index ")
-                && fork_message.starts_with("invalid type: a BigInt, expected ")
-            {
-                return Some(Rule::BufferedNumbers);
-            }
-            if hostile == Some("Map") && fork_message.starts_with("missing field `") {
-                return Some(Rule::MapNotSpec);
-            }
-            let (bk, bu, be) = buf_split?;
-            let (fk, fu, fe) = split(fork_message)?;
-            (be == fe
-                && fk == "type"
-                && (bk == "type" || bk == "value")
-                && same_value_named(bu, fu))
-            .then_some(Rule::TaggedPathAndNames)
-        }
+        ) => judge_tagged_errors((buf_path, buf_message), (fork_path, fork_message), hostile),
         _ => None,
     }
+}
+
+/// Whether the hostile value being fed is an array.
+fn is_array(hostile: Option<&str>) -> bool {
+    hostile.is_some_and(|h| {
+        h.starts_with('[') || h.starts_with("Array(") || h.contains("Proxy of an array")
+    })
+}
+
+/// [`judge_tagged`] of two errors, `(path, message)` each.
+fn judge_tagged_errors(
+    (buf_path, buf_message): (&str, &str),
+    (fork_path, fork_message): (&str, &str),
+    hostile: Option<&str>,
+) -> Option<Rule> {
+    if let Some(rule) =
+        buffer_read_otherwise((buf_path, buf_message), (fork_path, fork_message), hostile)
+    {
+        return Some(rule);
+    }
+    if !above(buf_path, fork_path) {
+        return None;
+    }
+    if buf_message == fork_message {
+        return Some(Rule::TaggedPathAndNames);
+    }
+    let buf_split = split(buf_message);
+    if let Some((_, _, expected)) = buf_split {
+        if expected == "any value" || expected.starts_with("internally tagged enum ") {
+            return Some(Rule::BufferCannotHold);
+        }
+        if expected == "string or map" || expected == "map with a single key" {
+            return Some(Rule::BufferedEnumNames);
+        }
+    }
+    if buf_message.starts_with("invalid length ")
+        && (buf_message.contains(", expected struct ")
+            || buf_message.ends_with(" elements in sequence"))
+    {
+        return Some(Rule::BufferedShapes);
+    }
+    if buf_message.starts_with("invalid type: byte array, expected ")
+        || (buf_message.starts_with("unknown variant `")
+            && fork_message.starts_with("invalid type: byte array, expected "))
+    {
+        // Bytes from the buffer are bytes, a variant's name among them.
+        return Some(Rule::BufferedShapes);
+    }
+    if buf_message.contains(", expected variant index ")
+        && fork_message.starts_with("invalid type: a BigInt, expected ")
+    {
+        return Some(Rule::BufferedNumbers);
+    }
+    let (bk, bu, be) = buf_split?;
+    let (fk, fu, fe) = split(fork_message)?;
+    (be == fe && fk == "type" && (bk == "type" || bk == "value") && same_value_named(bu, fu))
+        .then_some(Rule::TaggedPathAndNames)
+}
+
+/// The rules of [`judge_tagged_errors`] where the buffer read the value another way (as a map
+/// of all its entries, every property, a `Map`, an array by position), the paths related
+/// either way.
+fn buffer_read_otherwise(
+    (buf_path, buf_message): (&str, &str),
+    (fork_path, fork_message): (&str, &str),
+    hostile: Option<&str>,
+) -> Option<Rule> {
+    let buf_struct = buf_path
+        .strip_suffix(".?")
+        .or_else(|| {
+            buf_path
+                .strip_suffix('?')
+                .map(|p| if p.is_empty() { "." } else { p })
+        })
+        .unwrap_or(buf_path);
+    let throwing = matches!(
+        hostile,
+        Some("throwing getters" | "Proxy with throwing traps")
+    );
+    if (buf_message.starts_with("could not be read (") || throwing)
+        && (above(buf_path, fork_path) || above(fork_path, buf_path))
+    {
+        return Some(Rule::BufferReadsEverything);
+    }
+    let fork_struct = fork_message.starts_with("missing field `")
+        || (fork_message.starts_with("invalid type: ")
+            && fork_message.contains(", expected struct "));
+    if fork_struct
+        && above(buf_struct, fork_path)
+        && (buf_message == "TypeError: Reflect.get called on non-object"
+            || buf_message.starts_with("TypeError: Cannot perform %TypedArray%")
+            || buf_message == "TypeError: this is not a typed array."
+            || buf_message.ends_with(", expected field identifier")
+            || buf_message.ends_with(", expected a [key, value] pair"))
+    {
+        return Some(Rule::FlattenedReadAsMap);
+    }
+    if hostile == Some("Map") {
+        return Some(Rule::MapNotSpec);
+    }
+    if is_array(hostile)
+        && fork_message.starts_with("missing field `")
+        && (above(buf_path, fork_path) || above(fork_path, buf_path))
+    {
+        // From the buffer an array is a struct by position, an internally tagged
+        // enum's tag its first element.
+        return Some(Rule::BufferedShapes);
+    }
+    None
 }
 
 #[cfg(test)]
@@ -858,7 +877,12 @@ mod tests {
                 });
             }
         }
-        let state = with_state(std::mem::take);
+        check(with_state(std::mem::take), exported);
+    }
+
+    /// What the test asserts of a run: no difference beyond the rules, every rule needed,
+    /// every export fed and every type a JS argument is read into compared.
+    fn check(state: State, exported: usize) {
         assert!(
             state.failures.is_empty(),
             "{} kinds of reads differ from upstream beyond the rules:\n{}",
