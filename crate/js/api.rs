@@ -41,19 +41,29 @@ pub(crate) fn js_error(error: Error) -> JsValue {
 }
 
 /// Reads a JS value into `T`, naming the path of a bad field under `what`.
-pub(crate) fn from_js<T: DeserializeOwned>(value: JsValue, what: &str) -> Result<T, Error> {
+pub(crate) fn from_js<T: DeserializeOwned + std::fmt::Debug>(
+    value: JsValue,
+    what: &str,
+) -> Result<T, Error> {
     read(value, what, what)
 }
 
 /// Reads a spec (the one argument of `design`, `simulate`, …, the playground's `state`) into
 /// `T`: its fields are named from its root (`family`, `modes[0].damping`), the value itself
 /// `root` (`spec: is missing`).
-pub(crate) fn from_js_root<T: DeserializeOwned>(value: JsValue, root: &str) -> Result<T, Error> {
+pub(crate) fn from_js_root<T: DeserializeOwned + std::fmt::Debug>(
+    value: JsValue,
+    root: &str,
+) -> Result<T, Error> {
     read(value, "", root)
 }
 
 /// Reads `value`, naming a field inside it `prefix.path` and the value itself `root`.
-fn read<T: DeserializeOwned>(value: JsValue, prefix: &str, root: &str) -> Result<T, Error> {
+fn read<T: DeserializeOwned + std::fmt::Debug>(
+    value: JsValue,
+    prefix: &str,
+    root: &str,
+) -> Result<T, Error> {
     if value.is_undefined() || value.is_null() {
         return Err(Error::Parse {
             field: root.to_string(),
@@ -251,7 +261,7 @@ pub fn families() -> Result<JsValue, JsValue> {
 }
 
 /// Options of [`export_shaper`].
-#[derive(Deserialize)]
+#[derive(Debug, Deserialize)]
 #[serde(rename_all = "camelCase")]
 struct ExportOptions {
     /// `"csv"`, `"json"`, `"c"` or `"rrf"`.
@@ -320,7 +330,7 @@ pub fn klipper_figures(
     #[wasm_bindgen(unchecked_optional_param_type = "KlipperFiguresOptions | null")]
     options: JsValue,
 ) -> Result<JsValue, JsValue> {
-    #[derive(Deserialize)]
+    #[derive(Debug, Deserialize)]
     struct Options {
         #[serde(default = "default_scv")]
         scv: f64,

@@ -17,6 +17,9 @@ use wasm_bindgen::{JsCast, JsValue};
 
 type Result<T> = std::result::Result<T, Error>;
 
+#[cfg(test)]
+mod differential;
+
 #[wasm_bindgen::prelude::wasm_bindgen]
 extern "C" {
     /// `Object.entries(object)`, its exception caught: a getter or a Proxy trap may throw
@@ -27,8 +30,13 @@ extern "C" {
 
 /// [`try_entries`], a throw reported as an error of the value.
 fn entries_of(object: &JsValue) -> Result<Array> {
-    try_entries(object)
-        .map_err(|_| de::Error::custom("could not be read (a getter or a Proxy trap threw)"))
+    try_entries(object).map_err(|_| threw())
+}
+
+/// The error of a value whose reading threw.
+#[cold]
+fn threw() -> Error {
+    de::Error::custom("could not be read (a getter or a Proxy trap threw)")
 }
 
 /// One step of the path: an element index, a map key (or enum variant), or a non-string key.
@@ -96,9 +104,35 @@ fn note(error: Error) -> Error {
 
 /// Deserializes `value`; on failure, returns the path of the failing field (`.` for the value
 /// itself, as serde_path_to_error prints it) and the error.
-pub(crate) fn deserialize<T: DeserializeOwned>(
+///
+/// `Debug`: in the crate's tests every read is also made by upstream serde-wasm-bindgen with
+/// serde_path_to_error and by this reader with serde's own tagged-enum parser, and the three
+/// compared ([`differential`]).
+pub(crate) fn deserialize<T: DeserializeOwned + std::fmt::Debug>(
     value: JsValue,
 ) -> std::result::Result<T, (String, Error)> {
+    #[cfg(not(test))]
+    {
+        fork(value)
+    }
+    #[cfg(test)]
+    {
+        let upstream = differential::upstream::<T>(&value);
+        let buffered = differential::buffered(|| fork::<T>(value.clone()));
+        let read = fork::<T>(value.clone());
+        differential::compare(
+            core::any::type_name::<T>(),
+            &value,
+            upstream,
+            buffered,
+            &read,
+        );
+        read
+    }
+}
+
+/// [`deserialize`] by the fork alone.
+fn fork<T: DeserializeOwned>(value: JsValue) -> std::result::Result<T, (String, Error)> {
     #[cfg(feature = "any-deserializer")]
     crate::tagged::JS_READER.get_or_init(core::any::type_name::<De>);
     PATH.with(|p| p.borrow_mut().clear());
@@ -279,6 +313,14 @@ impl MapAccess {
                 None => return Ok(None),
                 Some(Err(e)) => return Err(fail_at(Segment::Unknown, Error::from(e))),
                 Some(Ok(pair)) => {
+                    // Not `[key, value]`: `null[0]` would throw through the module
+                    // (serde-wasm-bindgen's `convert_pair` lets it: `[null]` read where a
+                    // struct with a flattened part goes, through serde's buffered parser).
+                    if pair.loose_eq(&JsValue::NULL) {
+                        let e =
+                            de::Error::invalid_type(de::Unexpected::Unit, &"a [key, value] pair");
+                        return Err(fail_at(Segment::Unknown, e));
+                    }
                     let (key, value) = convert_pair(pair);
                     self.value = Some(value);
                     key
@@ -297,10 +339,13 @@ impl MapAccess {
                 let mut found = None;
                 for field in fields.by_ref() {
                     let js_field = JsValue::from(JsString::from(*field));
-                    let value = js_sys::Reflect::get(object, &js_field).unwrap_or_default();
+                    // A getter or a Proxy trap that throws: an error of that field (not a
+                    // missing field, nor an exception through the module).
+                    let throws = |_| fail_at(Segment::Key(field.to_string()), threw());
+                    let value = js_sys::Reflect::get(object, &js_field).map_err(throws)?;
                     // `undefined` may be a missing field: check with `in`.
                     let missing = value.is_undefined()
-                        && !js_sys::Reflect::has(object, &js_field).unwrap_or(false);
+                        && !js_sys::Reflect::has(object, &js_field).map_err(throws)?;
                     if !missing {
                         found = Some((*field, value));
                         break;
@@ -567,9 +612,12 @@ impl De {
             self.seq(visitor)
         } else if let Some(bytes) = self.as_bytes() {
             visitor.visit_byte_buf(bytes)
-        } else if self.value.is_object()
-            && (!Symbol::iterator().js_in(&self.value) || self.value.has_type::<Map>())
-        {
+        } else if self.value.is_object() && {
+            // `Symbol.iterator in value`, a Proxy's `has` trap's throw caught.
+            let iterable = js_sys::Reflect::has(&self.value, Symbol::iterator().as_ref())
+                .map_err(|_| threw())?;
+            !iterable || self.value.has_type::<Map>()
+        } {
             self.map(visitor)
         } else {
             self.invalid_type(visitor)
@@ -580,6 +628,10 @@ impl De {
         if let Some(arr) = self.value.dyn_ref::<Array>() {
             check_length(arr.length() as f64)?;
             visitor.visit_seq(SeqAccess::array(arr.clone()))
+        } else if !self.value.is_object() {
+            // Not asked for its `Symbol.iterator`: `Reflect.get` throws on a number or a string
+            // (serde-wasm-bindgen reports that `TypeError` as the error).
+            self.invalid_type(visitor)
         } else if let Some(iter) = js_sys::try_iter(&self.value)? {
             if ArrayBuffer::is_view(&self.value) {
                 // A typed array's `length`, read before its elements are: 2²⁶ + 1 of them would
@@ -598,6 +650,10 @@ impl De {
     }
 
     fn map<'de, V: Visitor<'de>>(self, visitor: V) -> Result<V::Value> {
+        if !self.value.is_object() {
+            // As in `seq`: not a `TypeError` from `Reflect.get` on a primitive.
+            return self.invalid_type(visitor);
+        }
         match js_sys::try_iter(&self.value)? {
             Some(iter) => visitor.visit_map(MapAccess::new(MapSource::Iter(iter))),
             None => {
@@ -661,8 +717,8 @@ impl De {
             return self.invalid_type(visitor);
         }
         let key = JsValue::from_str(field);
-        let tag = js_sys::Reflect::get(&self.value, &key)?;
-        if tag.is_undefined() && !js_sys::Reflect::has(&self.value, &key)? {
+        let tag = js_sys::Reflect::get(&self.value, &key).map_err(|_| threw())?;
+        if tag.is_undefined() && !js_sys::Reflect::has(&self.value, &key).map_err(|_| threw())? {
             return Err(de::Error::missing_field(field));
         }
         visitor.visit_enum(EnumAccess {

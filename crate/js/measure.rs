@@ -47,7 +47,7 @@ fn recording_error(e: RecordingError) -> JsValue {
 }
 
 /// Options object, `{}` when missing.
-pub(super) fn options<T: serde::de::DeserializeOwned + Default>(
+pub(super) fn options<T: serde::de::DeserializeOwned + Default + std::fmt::Debug>(
     value: JsValue,
     what: &str,
 ) -> Result<T, Error> {
@@ -313,7 +313,7 @@ pub fn fft_spectrum_js(
     Ok(out.into())
 }
 
-#[derive(Deserialize, Default)]
+#[derive(Debug, Deserialize, Default)]
 #[serde(rename_all = "camelCase", default)]
 struct ChannelChoice {
     channel: Option<serde_json_like::ChannelKey>,
@@ -324,6 +324,7 @@ mod serde_json_like {
     use std::fmt;
 
     /// A channel by name or index.
+    #[derive(Debug)]
     pub(super) enum ChannelKey {
         Index(usize),
         Name(String),
@@ -583,7 +584,7 @@ fn measured_spectrum(js: &JsValue) -> Result<MeasuredSpectrum, Error> {
     })
 }
 
-#[derive(Deserialize, Default)]
+#[derive(Debug, Deserialize, Default)]
 #[serde(rename_all = "camelCase", default)]
 struct DrawOptions {
     peaks_hz: Vec<f64>,
@@ -661,7 +662,7 @@ pub(super) fn css_hex(s: &str) -> Option<RGBColor> {
 }
 
 #[cfg(feature = "js-recording")]
-#[derive(Deserialize, Default)]
+#[derive(Debug, Deserialize, Default)]
 #[serde(rename_all = "camelCase", default)]
 struct KlipperDrawOptions {
     max_hz: Option<f64>,
@@ -748,7 +749,7 @@ pub fn firmware_config_js(
     #[wasm_bindgen(unchecked_param_type = "FirmwareConfigRequest")] request: JsValue,
 ) -> Result<JsValue, JsValue> {
     use crate::export::firmware::{firmware_config, AxisShaper, Firmware};
-    #[derive(Deserialize)]
+    #[derive(Debug, Deserialize)]
     struct Request {
         firmware: Firmware,
         axes: Vec<AxisShaper>,

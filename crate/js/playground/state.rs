@@ -22,7 +22,7 @@ use super::super::api::from_js_root;
 const MAX_COMPARED: usize = 4;
 
 /// What the page shows, in one object (see `renderPlayground`).
-#[derive(Deserialize)]
+#[derive(Debug, Deserialize)]
 #[serde(rename_all = "camelCase")]
 struct PlaygroundState {
     modes: Vec<ModeSpec>,
@@ -43,7 +43,7 @@ struct PlaygroundState {
     designed: Vec<Option<ShaperData>>,
 }
 
-#[derive(Deserialize)]
+#[derive(Debug, Deserialize)]
 #[serde(rename_all = "camelCase", default)]
 pub(super) struct PlaygroundView {
     /// Sensitivity range, Hz; defaults to 0 … 2 × the highest mode.
@@ -115,7 +115,7 @@ crate::tagged::tagged_enum! {
     tag = "kind", rename_all = "camelCase", mirror = view_plant_serde;
     /// The playground's simulated plant: `modal` (the modes × mismatch, equal participation) or
     /// `pendulum` (a nonlinear crane pendulum whose linearised mode is the first mode × mismatch).
-    #[derive(Clone, Copy)]
+    #[derive(Debug, Clone, Copy)]
     pub(super) enum ViewPlant {
         Modal,
         #[serde(rename_all = "camelCase")]
