@@ -49,7 +49,7 @@ layer fmt cargo fmt --check
 layer clippy cargo clippy --all-targets -- -D warnings
 layer clippy-wasm cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
 # The page's modules are built from subsets of the features (scripts/build.sh).
-layer clippy-page-modules bash -c 'for f in js-playground js-designer,solver js-recording; do cargo clippy --target wasm32-unknown-unknown --lib --no-default-features --features "$f" -- -D warnings || exit 1; done'
+layer clippy-page-modules bash -c 'for f in js-playground js-designer,solver js-recording js-corner; do cargo clippy --target wasm32-unknown-unknown --lib --no-default-features --features "$f" -- -D warnings || exit 1; done'
 # The public API's rustdoc builds without warnings (broken or private intra-doc links).
 layer doc env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib
 layer doc-wasm env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib --target wasm32-unknown-unknown
