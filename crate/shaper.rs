@@ -303,23 +303,7 @@ impl Shaper {
         // V of the product is the product of the factors' V (the transform of a convolution is
         // the product of the transforms; merging coincident impulses and dropping cancelled
         // ones change neither).
-        let factors: Vec<Vec<Impulse>> = self
-            .factors()
-            .chain(other.factors())
-            .filter(|f| !is_unit(f))
-            .map(<[Impulse]>::to_vec)
-            .collect();
-        let n = factors
-            .iter()
-            .try_fold(1_usize, |n, f| n.checked_mul(f.len()))
-            .unwrap_or(usize::MAX);
-        if n > MAX_CONVOLVED_IMPULSES {
-            return Err(Error::TooLarge {
-                field: "impulses".into(),
-                value: n as f64,
-                limit: MAX_CONVOLVED_IMPULSES as f64,
-            });
-        }
+        let (factors, n) = self.product_factors(other)?;
         if n > MAX_IMPULSES {
             return Shaper::factored(factors);
         }
@@ -340,10 +324,9 @@ impl Shaper {
         Ok(shaper)
     }
 
-    /// The convolution of two shapers kept factored (see [`Shaper`]) whatever its size, up to
-    /// [`MAX_CONVOLVED_IMPULSES`] products: the same shaper as [`Shaper::convolve`] (the same
-    /// impulses once formed), analysed from its factors. Errors as [`Shaper::convolve`]'s.
-    pub fn convolve_factored(&self, other: &Shaper) -> Result<Shaper> {
+    /// The factors of `self ⊛ other` (the identity's left out) and how many products they
+    /// make; more than [`MAX_CONVOLVED_IMPULSES`] is an error.
+    fn product_factors(&self, other: &Shaper) -> Result<(Vec<Vec<Impulse>>, usize)> {
         let factors: Vec<Vec<Impulse>> = self
             .factors()
             .chain(other.factors())
@@ -361,6 +344,14 @@ impl Shaper {
                 limit: MAX_CONVOLVED_IMPULSES as f64,
             });
         }
+        Ok((factors, n))
+    }
+
+    /// The convolution of two shapers kept factored (see [`Shaper`]) whatever its size, up to
+    /// [`MAX_CONVOLVED_IMPULSES`] products: the same shaper as [`Shaper::convolve`] (the same
+    /// impulses once formed), analysed from its factors. Errors as [`Shaper::convolve`]'s.
+    pub fn convolve_factored(&self, other: &Shaper) -> Result<Shaper> {
+        let (factors, _) = self.product_factors(other)?;
         if factors.len() < 2 {
             // A single factor (the other was the identity) is that shaper.
             return Ok(factors

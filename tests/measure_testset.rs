@@ -13,7 +13,7 @@ use input_shaping::measure::identify::{
     identify, identify_spectrum, IdentifiedMode, IdentifyOptions, MAX_MODES,
 };
 use input_shaping::measure::recording::{parse_file, Parsed, RecordingOptions};
-use input_shaping::measure::spectrum_file::combine_spectra;
+use input_shaping::measure::spectrum_file::{combine_spectra, SpectrumFile};
 use serde_json::Value;
 use std::path::Path;
 mod common;
@@ -380,6 +380,18 @@ fn synthetic_resonances(
 /// three modes, ζ 0.01 to 0.15, a mode 4 dB weaker at a ratio 1.4; 20 and 80 Welch segments),
 /// identified with `maxModes` = 8, the most: as many modes found as there are, none added,
 /// and with 80 segments each within issue 20's targets.
+/// A generated resonances file's text, parsed as the spectrum file it must be.
+fn spectrum_of(text: &str, name: &str) -> SpectrumFile {
+    let options = RecordingOptions {
+        file_name: Some(name.to_string()),
+        ..RecordingOptions::default()
+    };
+    match parse_file(text, &options).unwrap() {
+        Parsed::Spectrum(spectrum) => spectrum,
+        Parsed::Recording(_) => panic!("{name}: not a spectrum"),
+    }
+}
+
 #[test]
 fn no_spurious_modes_over_noise_draws() {
     let sets: [&[(f64, f64, f64)]; 4] = [
@@ -396,16 +408,7 @@ fn no_spurious_modes_over_noise_draws() {
             for draw in 0..3 {
                 let text = synthetic_resonances(modes, 20.0, k, f64::INFINITY, &mut rng);
                 let name = format!("resonances_x_set{s}_k{k}_{draw}.csv");
-                let Parsed::Spectrum(spectrum) = parse_file(
-                    &text,
-                    &RecordingOptions {
-                        file_name: Some(name.clone()),
-                        ..RecordingOptions::default()
-                    },
-                )
-                .unwrap() else {
-                    panic!("{name}: not a spectrum");
-                };
+                let spectrum = spectrum_of(&text, &name);
                 let id = identify_spectrum(
                     &spectrum,
                     &IdentifyOptions {
@@ -468,16 +471,7 @@ fn the_sweeps_end_is_not_a_mode() {
         for draw in 0..2 {
             let text = synthetic_resonances(modes, 20.0, 80, 133.3, &mut rng);
             let name = format!("resonances_x_end{s}_{draw}.csv");
-            let Parsed::Spectrum(spectrum) = parse_file(
-                &text,
-                &RecordingOptions {
-                    file_name: Some(name.clone()),
-                    ..RecordingOptions::default()
-                },
-            )
-            .unwrap() else {
-                panic!("{name}: not a spectrum");
-            };
+            let spectrum = spectrum_of(&text, &name);
             let id = identify_spectrum(&spectrum, &IdentifyOptions::new(f64::NAN)).unwrap();
             let found = found_of(&id.modes);
             at_cliff.extend(

@@ -4,11 +4,9 @@
 
 use super::api::{from_js, from_js_root, js_error, to_js};
 use super::args;
-use super::canvas::Canvas;
-use crate::chart::{self, ChartStyle, CornerTrack};
+use crate::chart::{self, CornerTrack};
 use crate::corner::CornerRinging;
 use crate::design::ShaperSpec;
-use crate::error::Error;
 use crate::scenario::{CornerSetup, CornerSpec};
 use plotters::prelude::IntoDrawingArea;
 use serde::{Deserialize, Serialize};
@@ -120,18 +118,7 @@ pub fn render_corner(
             }),
         }
     }
-    let style = ChartStyle {
-        scale: o
-            .pixel_ratio
-            .filter(|r| r.is_finite() && *r > 0.0)
-            .unwrap_or(1.0),
-        ..ChartStyle::default()
-    };
-    let backend = Canvas::new(canvas).ok_or_else(|| {
-        js_error(Error::Render {
-            reason: "the canvas has no 2D context".into(),
-        })
-    })?;
+    let (backend, style) = super::measure::canvas_and_style(canvas, o.pixel_ratio)?;
     let mut points: Vec<[f64; 2]> = setup.plan.segments.iter().map(|s| s.start).collect();
     points.extend(setup.plan.segments.last().map(|s| s.end));
     let tracks: Vec<CornerTrack<'_>> = prints
