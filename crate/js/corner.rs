@@ -15,7 +15,7 @@ use wasm_bindgen::prelude::*;
 /// Most shapers compared at once.
 const MAX_SHAPERS: usize = 8;
 
-#[derive(Deserialize, Default)]
+#[derive(Deserialize, Default, Debug)]
 #[serde(rename_all = "camelCase", default)]
 struct CornerOptions {
     pixel_ratio: Option<f64>,

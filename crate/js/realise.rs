@@ -14,7 +14,7 @@ use wasm_bindgen::prelude::*;
 
 /// One compared shaper's two curves (JS: `{ label, color?, ideal, realised }`, each curve
 /// `{ frequencyHz, vibration }` as `realizeShaper` returns them with `curve`).
-#[derive(Deserialize)]
+#[derive(Deserialize, Debug)]
 #[serde(rename_all = "camelCase")]
 struct Entry {
     label: String,
@@ -25,7 +25,7 @@ struct Entry {
 }
 
 /// `drawRealisation`'s data (JS: `{ shapers, vtol?, modesHz? }`).
-#[derive(Deserialize)]
+#[derive(Deserialize, Debug)]
 #[serde(rename_all = "camelCase")]
 struct Data {
     shapers: Vec<Entry>,
@@ -35,7 +35,7 @@ struct Data {
     modes_hz: Vec<f64>,
 }
 
-#[derive(Deserialize, Default)]
+#[derive(Deserialize, Default, Debug)]
 #[serde(rename_all = "camelCase", default)]
 struct DrawOptions {
     pixel_ratio: Option<f64>,
