@@ -259,7 +259,7 @@ impl Shaper {
     /// only ones at their times, so they are neither merged nor cancelled).
     pub fn duration(&self) -> f64 {
         if self.factored {
-            return self.factors.iter().map(|f| last_time(f)).sum();
+            return self.factored_duration();
         }
         last_time(self.impulses())
     }
@@ -268,7 +268,7 @@ impl Shaper {
     /// factored shaper the product of the factors' sums.
     pub fn amplitude_sum(&self) -> f64 {
         if self.factored {
-            return self.factors.iter().map(|f| sum_of(f)).product();
+            return self.factored_sum();
         }
         sum_of(self.impulses())
     }
@@ -280,17 +280,33 @@ impl Shaper {
     /// normalised first moments times the product of their sums).
     pub fn centroid_delay(&self) -> Option<f64> {
         if self.factored {
-            if self.amplitude_sum().abs() < 1e-15 {
-                return None;
-            }
-            return self
-                .factors
-                .iter()
-                .map(|f| centroid_of(f))
-                .sum::<Option<f64>>()
-                .filter(|d| d.is_finite());
+            return self.factored_centroid();
         }
         centroid_of(self.impulses())
+    }
+
+    // The factored shaper's summaries, out of line: inlined at every caller of `duration`,
+    // `amplitude_sum` and `centroid_delay` they cost the page's module kilobytes.
+    #[inline(never)]
+    fn factored_duration(&self) -> f64 {
+        self.factors.iter().map(|f| last_time(f)).sum()
+    }
+
+    #[inline(never)]
+    fn factored_sum(&self) -> f64 {
+        self.factors.iter().map(|f| sum_of(f)).product()
+    }
+
+    #[inline(never)]
+    fn factored_centroid(&self) -> Option<f64> {
+        if self.factored_sum().abs() < 1e-15 {
+            return None;
+        }
+        self.factors
+            .iter()
+            .map(|f| centroid_of(f))
+            .sum::<Option<f64>>()
+            .filter(|d| d.is_finite())
     }
 
     /// The convolution of two shapers: every pair of impulses multiplied, times added.
