@@ -48,32 +48,7 @@ pub struct KlipperFigures {
 /// ```
 pub fn smoothing(shaper: &Shaper, accel: f64, scv: f64) -> Result<f64> {
     in_range("accel", accel)?;
-    in_range("scv", scv)?;
-    let d = shaper.amplitude_sum();
-    let ts = shaper.centroid_delay().ok_or_else(|| {
-        Error::invalid(
-            "impulses",
-            "the amplitudes sum to zero; smoothing is undefined",
-        )
-    })?;
-    let half = 0.5 * accel;
-    let (mut o90, mut o180) = (0.0, 0.0);
-    for imp in shaper.impulses() {
-        let dt = imp.time - ts;
-        if imp.time >= ts {
-            o90 += imp.amplitude * (scv + half * dt) * dt;
-        }
-        o180 += imp.amplitude * half * dt * dt;
-    }
-    let smoothing = (o90 * std::f64::consts::SQRT_2 / d).max(o180 / d);
-    if smoothing.is_finite() {
-        Ok(smoothing)
-    } else {
-        Err(Error::invalid(
-            "impulses",
-            format!("smoothing overflows ({smoothing}) for this shaper at {accel} mm/s²"),
-        ))
-    }
+    Moments::of(shaper, scv)?.checked_smoothing(accel)
 }
 
 /// Largest acceleration or square corner velocity accepted (mm/s², mm/s).
@@ -115,15 +90,8 @@ pub fn max_accel(shaper: &Shaper, scv: f64) -> Result<f64> {
     // [`smoothing`]): three sums over the impulses, formed once, serve every step of the
     // bisection (~60), where each step walked the impulses (15 625 for ZV-D³ over six modes).
     let moments = Moments::of(shaper, scv)?;
-    let ok = |a: f64| -> Result<bool> {
-        let s = moments.smoothing(a);
-        if s.is_finite() {
-            Ok(s <= KLIPPER_TARGET_SMOOTHING)
-        } else {
-            // The same error as `smoothing` gives.
-            Ok(smoothing(shaper, a, scv)? <= KLIPPER_TARGET_SMOOTHING)
-        }
-    };
+    let ok =
+        |a: f64| -> Result<bool> { Ok(moments.checked_smoothing(a)? <= KLIPPER_TARGET_SMOOTHING) };
     if !ok(1e-9)? {
         return Ok(0.0);
     }
@@ -156,8 +124,10 @@ pub fn max_accel(shaper: &Shaper, scv: f64) -> Result<f64> {
     Ok(left)
 }
 
-/// [`smoothing`]'s sums with the acceleration factored out: with dt = t − t_s,
-/// o90 = scv·Σ_{t≥t_s} A dt + a/2·Σ_{t≥t_s} A dt², o180 = a/2·Σ A dt².
+/// The sums behind [`smoothing`], with the acceleration factored out: with dt = t − t_s,
+/// o90 = scv·Σ_{t≥t_s} A dt + a/2·Σ_{t≥t_s} A dt², o180 = a/2·Σ A dt². Smoothing is linear in
+/// the acceleration on each side of that split, so one pass over the impulses serves every
+/// acceleration (the bisection of [`max_accel`] takes ~60).
 struct Moments {
     sum: f64,
     scv: f64,
@@ -194,11 +164,20 @@ impl Moments {
         })
     }
 
-    /// [`smoothing`] at acceleration `a` (the same number to rounding).
-    fn smoothing(&self, a: f64) -> f64 {
+    /// [`smoothing`] at acceleration `a`: max(√2·o90, o180) / Σ A, or an error if it overflows.
+    fn checked_smoothing(&self, a: f64) -> Result<f64> {
         let half = 0.5 * a;
         let o90 = self.scv * self.late1 + half * self.late2;
-        (o90 * std::f64::consts::SQRT_2 / self.sum).max(half * self.all2 / self.sum)
+        let smoothing =
+            (o90 * std::f64::consts::SQRT_2 / self.sum).max(half * self.all2 / self.sum);
+        if smoothing.is_finite() {
+            Ok(smoothing)
+        } else {
+            Err(Error::invalid(
+                "impulses",
+                format!("smoothing overflows ({smoothing}) for this shaper at {a} mm/s²"),
+            ))
+        }
     }
 }
 
