@@ -446,8 +446,9 @@ pub fn simulate(
 
 /// `spectrum(spec)`: `spec = { command, shaper? | impulses?, plant?, fromHz?, toHz?, points?,
 /// signal? }` → `{ frequencyHz, magnitude, unshaped, modesHz }` (|U(f)| of the shaped and the
-/// unshaped command's velocity by default).
-#[cfg(feature = "js-api")]
+/// unshaped command's velocity by default). Also in the page's lazily fetched module
+/// (`js-recording`), for its profile view (web/command_view.js).
+#[cfg(any(feature = "js-api", feature = "js-recording"))]
 #[wasm_bindgen(unchecked_return_type = "SpectrumResult")]
 pub fn spectrum(
     #[wasm_bindgen(unchecked_param_type = "SpectrumSpec")] spec: JsValue,
@@ -455,6 +456,37 @@ pub fn spectrum(
     let spec: crate::scenario::SpectrumSpec = from_js_root(spec, "spec").map_err(js_error)?;
     let result = crate::scenario::spectrum_for(&spec).map_err(js_error)?;
     to_js(&result)
+}
+
+/// `profileZeros(command, upToHz)` → `[{ frequencyHz, order, finalPulse }]`: the frequencies
+/// in (0, upToHz] where the spectrum of a pulse-convolution profile (`command = { kind:
+/// "profile", shape, … }`) is zero, in closed form (crate::profile::spectrum_zeros: Veciana &
+/// Cardona 2011 eq. 13 for each pulse, their product by eqs. 9–12); `order` counts the pulses
+/// vanishing there, `finalPulse` says the final pulse is one of them. Errors name
+/// `command.<field>` (another kind: `command.kind`) or `upToHz`. Also in the page's lazily
+/// fetched module (`js-recording`), for its profile view (web/command_view.js).
+#[cfg(any(feature = "js-api", feature = "js-recording"))]
+#[wasm_bindgen(js_name = profileZeros, unchecked_return_type = "ProfileZero[]")]
+pub fn profile_zeros(
+    #[wasm_bindgen(unchecked_param_type = "CommandSpec")] command: JsValue,
+    #[wasm_bindgen(js_name = upToHz, unchecked_param_type = "number")] up_to_hz: JsValue,
+) -> Result<JsValue, JsValue> {
+    let spec: crate::command::CommandSpec = from_js(command, "command").map_err(js_error)?;
+    let crate::command::CommandSpec::Profile(profile) = spec else {
+        return Err(js_error(Error::invalid(
+            "command.kind",
+            "the spectrum zeros are known in closed form for a profile command only (kind: \"profile\")",
+        )));
+    };
+    let up_to = super::args::number(&up_to_hz, "upToHz").map_err(js_error)?;
+    let zeros = crate::profile::spectrum_zeros(&profile, up_to).map_err(|e| {
+        js_error(if e.field() == Some("upToHz") {
+            e
+        } else {
+            e.within("command")
+        })
+    })?;
+    to_js(&zeros)
 }
 
 /// `simulateCorner(spec)`: `spec = { path: { kind: "square", sideMm } | { kind:

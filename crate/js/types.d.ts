@@ -414,6 +414,15 @@ export interface SpectrumResult {
   modesHz: number[];
 }
 
+/** A zero of a profile's spectrum (`profileZeros`). */
+export interface ProfileZero {
+  frequencyHz: number;
+  /** How many pulses vanish there (2: a tangent zero). */
+  order: number;
+  /** The final pulse (the rest of `duration`) is one of them. */
+  finalPulse: boolean;
+}
+
 // ---------------------------------------------------------------------------------------------
 // The printed corner (simulateCorner)
 
