@@ -151,13 +151,6 @@ pub fn pulse_durations(spec: &ProfileSpec) -> Result<Vec<f64>> {
 
 /// The position command of a profile spec (its velocity is the pulse convolution).
 pub fn from_spec(spec: &ProfileSpec) -> Result<Piecewise> {
-    let (widths, distance) = all_pulses(spec)?;
-    position_from_pulses(&widths, distance)
-}
-
-/// Every pulse of a profile spec, the final one last (the rest of `duration`, ≥ 0), and its
-/// distance; validated.
-fn all_pulses(spec: &ProfileSpec) -> Result<(Vec<f64>, f64)> {
     let (distance, duration) = match spec {
         ProfileSpec::Pulse {
             distance, duration, ..
@@ -188,7 +181,7 @@ fn all_pulses(spec: &ProfileSpec) -> Result<(Vec<f64>, f64)> {
         ));
     }
     widths.push(last.max(0.0));
-    Ok((widths, distance))
+    position_from_pulses(&widths, distance)
 }
 
 /// Most zeros [`spectrum_zeros`] lists.
@@ -216,7 +209,16 @@ pub struct SpectrumZero {
 /// are one zero of higher `order`. A zero-width final pulse (a Dirac) has none. Errors: a bad
 /// spec (as [`from_spec`]), `upToHz` not positive, more than [`MAX_ZEROS`] zeros (`tooLarge`).
 pub fn spectrum_zeros(spec: &ProfileSpec, up_to_hz: f64) -> Result<Vec<SpectrumZero>> {
-    let (widths, _) = all_pulses(spec)?;
+    // Validated as from_spec validates it (the same errors); the final pulse takes the rest.
+    from_spec(spec)?;
+    let duration = match spec {
+        ProfileSpec::Pulse { duration, .. }
+        | ProfileSpec::Triangle { duration, .. }
+        | ProfileSpec::RobustTrapezium { duration, .. }
+        | ProfileSpec::MultiMode { duration, .. } => *duration,
+    };
+    let mut widths = pulse_durations(spec)?;
+    widths.push((duration - widths.iter().sum::<f64>()).max(0.0));
     positive("upToHz", up_to_hz)?;
     let last = widths.len() - 1;
     let count: f64 = widths.iter().map(|w| (up_to_hz * w).floor()).sum();

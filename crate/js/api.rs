@@ -446,9 +446,8 @@ pub fn simulate(
 
 /// `spectrum(spec)`: `spec = { command, shaper? | impulses?, plant?, fromHz?, toHz?, points?,
 /// signal? }` → `{ frequencyHz, magnitude, unshaped, modesHz }` (|U(f)| of the shaped and the
-/// unshaped command's velocity by default). Also in the page's lazily fetched module
-/// (`js-recording`), for its profile view (web/command_view.js).
-#[cfg(any(feature = "js-api", feature = "js-recording"))]
+/// unshaped command's velocity by default).
+#[cfg(feature = "js-api")]
 #[wasm_bindgen(unchecked_return_type = "SpectrumResult")]
 pub fn spectrum(
     #[wasm_bindgen(unchecked_param_type = "SpectrumSpec")] spec: JsValue,
@@ -458,18 +457,30 @@ pub fn spectrum(
     to_js(&result)
 }
 
-/// `profileZeros(command, upToHz)` → `[{ frequencyHz, order, finalPulse }]`: the frequencies
-/// in (0, upToHz] where the spectrum of a pulse-convolution profile (`command = { kind:
-/// "profile", shape, … }`) is zero, in closed form (crate::profile::spectrum_zeros: Veciana &
-/// Cardona 2011 eq. 13 for each pulse, their product by eqs. 9–12); `order` counts the pulses
-/// vanishing there, `finalPulse` says the final pulse is one of them. Errors name
-/// `command.<field>` (another kind: `command.kind`) or `upToHz`. Also in the page's lazily
-/// fetched module (`js-recording`), for its profile view (web/command_view.js).
+/// A profile's spectrum and its zeros (`profileSpectrum`).
 #[cfg(any(feature = "js-api", feature = "js-recording"))]
-#[wasm_bindgen(js_name = profileZeros, unchecked_return_type = "ProfileZero[]")]
-pub fn profile_zeros(
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct ProfileSpectrum {
+    frequency_hz: Vec<f64>,
+    magnitude: Vec<f64>,
+    zeros: Vec<crate::profile::SpectrumZero>,
+}
+
+/// `profileSpectrum(command, { fromHz?, toHz, points?, signal? })` → `{ frequencyHz, magnitude,
+/// zeros: [{ frequencyHz, order, finalPulse }] }`: |U(f)| of a pulse-convolution profile
+/// (`command = { kind: "profile", shape, … }`; as `spectrum` computes it, of the velocity by
+/// default) and the frequencies in (0, toHz] where it is zero, in closed form
+/// (crate::profile::spectrum_zeros: Veciana & Cardona 2011 eq. 13 for each pulse, their product
+/// by eqs. 9–12); `order` counts the pulses vanishing there, `finalPulse` says the final pulse
+/// is one of them. Errors name `command.<field>` (another kind: `command.kind`) or
+/// `options.<field>`. Also in the page's lazily fetched module (`js-recording`), for its
+/// profile view (web/command_view.js).
+#[cfg(any(feature = "js-api", feature = "js-recording"))]
+#[wasm_bindgen(js_name = profileSpectrum, unchecked_return_type = "ProfileSpectrum")]
+pub fn profile_spectrum(
     #[wasm_bindgen(unchecked_param_type = "CommandSpec")] command: JsValue,
-    #[wasm_bindgen(js_name = upToHz, unchecked_param_type = "number")] up_to_hz: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "SpectrumOptions")] options: JsValue,
 ) -> Result<JsValue, JsValue> {
     let spec: crate::command::CommandSpec = from_js(command, "command").map_err(js_error)?;
     let crate::command::CommandSpec::Profile(profile) = spec else {
@@ -478,15 +489,27 @@ pub fn profile_zeros(
             "the spectrum zeros are known in closed form for a profile command only (kind: \"profile\")",
         )));
     };
-    let up_to = super::args::number(&up_to_hz, "upToHz").map_err(js_error)?;
-    let zeros = crate::profile::spectrum_zeros(&profile, up_to).map_err(|e| {
-        js_error(if e.field() == Some("upToHz") {
-            e
-        } else {
-            e.within("command")
+    let options: crate::spectrum::SpectrumOptions =
+        from_js(options, "options").map_err(js_error)?;
+    let position =
+        crate::profile::from_spec(&profile).map_err(|e| js_error(e.within("command")))?;
+    let u = crate::spectrum::piecewise_spectrum(&position, &options)
+        .map_err(|e| js_error(e.within("options")))?;
+    let zeros = crate::profile::spectrum_zeros(&profile, options.to_hz).map_err(|e| {
+        js_error(match e {
+            Error::TooLarge { value, limit, .. } => Error::TooLarge {
+                field: "options.toHz".into(),
+                value,
+                limit,
+            },
+            e => e.within("command"),
         })
     })?;
-    to_js(&zeros)
+    to_js(&ProfileSpectrum {
+        frequency_hz: u.frequency_hz,
+        magnitude: u.magnitude,
+        zeros,
+    })
 }
 
 /// `simulateCorner(spec)`: `spec = { path: { kind: "square", sideMm } | { kind:

@@ -19,7 +19,7 @@ import init, {
   realizeShaper,
   simulate,
   spectrum,
-  profileZeros,
+  profileSpectrum,
   simulateCorner,
   renderCorner,
   renderPlayground,
@@ -123,8 +123,8 @@ export async function main(canvas: HTMLCanvasElement): Promise<void> {
   });
   const swing: number[] | undefined = crane.unshaped.swingAngle;
   const u = spectrum({ command: { kind: "step" }, shaper: { family: "zv", modes: [mode] }, toHz: 10 });
-  const zeros = profileZeros({ kind: "profile", shape: "pulse", frequencyHz: 2, distance: 1, duration: 1 }, 10);
-  const firstZero: number = zeros[0].frequencyHz + zeros[0].order + (zeros[0].finalPulse ? 1 : 0);
+  const ps = profileSpectrum({ kind: "profile", shape: "pulse", frequencyHz: 2, distance: 1, duration: 1 }, { toHz: 10 });
+  const firstZero: number = ps.zeros[0].frequencyHz + ps.zeros[0].order + (ps.zeros[0].finalPulse ? 1 : 0) + ps.magnitude[0];
   void firstZero;
   console.log(residual, swing, u.magnitude[0]);
 
