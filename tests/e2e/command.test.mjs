@@ -72,11 +72,12 @@ test('a profile picked on the default page: its fields, its zeros, a bad duratio
   await page.selectOption('#command-kind', 'profile');
   await page.waitForSelector('#command-view:not([hidden])', { timeout: 20000 });
   await settle(page);
-  // The default: Veciana's triangle for mode 1 (2 Hz), 3 periods long; its double zero at 2 Hz.
+  // The default: Veciana's triangle for mode 1 (2 Hz), 2.6 periods long; its double zeros at
+  // k × 2 Hz; the final pulse's (0.3 s: every 3.33 Hz) are not marked.
   assert.equal(await page.$eval('#command-shape', (n) => n.value), 'triangle');
   assert.equal(await page.$eval('#command-frequencyHz', (n) => n.value), '2');
-  assert.equal(await page.$eval('#command-duration', (n) => n.value), '1.5');
-  assert.match(await zerosText(page), /^Zeros of the triangle profile .*: 2 Hz \(order 2: tangent\) = mode 1; 4 Hz \(order 2: tangent\)/);
+  assert.equal(await page.$eval('#command-duration', (n) => n.value), '1.3');
+  assert.match(await zerosText(page), /^Zeros of the triangle profile .*: 2 Hz \(order 2: tangent\) = mode 1; 4 Hz \(order 2: tangent\); 6 Hz \(order 2: tangent\)\. The final pulse adds zeros every 3\.333 Hz/);
   // The robust trapezium (Fig. 8): zeros at f₀ ± Δf, Δf = 10 % of f₀ by default.
   await page.selectOption('#command-shape', 'robustTrapezium');
   await settle(page);
@@ -88,10 +89,10 @@ test('a profile picked on the default page: its fields, its zeros, a bad duratio
   await settle(page);
   text = await zerosText(page);
   assert.match(text, /: 1\.9 Hz; 2\.1 Hz;/, text);
-  const lib = await libraryZeros(page, { kind: 'profile', shape: 'robustTrapezium', frequencyHz: 2, deltaHz: 0.1, distance: 0.75, duration: 1.5 }, 6);
+  const lib = await libraryZeros(page, { kind: 'profile', shape: 'robustTrapezium', frequencyHz: 2, deltaHz: 0.1, distance: 1, duration: 1.3 }, 6);
   assert.deepEqual(lib.filter((z) => !z.finalPulse).slice(0, 2).map((z) => fmt(z.frequencyHz)), ['1.9', '2.1']);
   const state = await stateOf(page);
-  assert.deepEqual(state.view.command, { kind: 'profile', distance: 1, shape: 'robustTrapezium', frequencyHz: 2, duration: 1.5, deltaHz: 0.1 });
+  assert.deepEqual(state.view.command, { kind: 'profile', distance: 1, shape: 'robustTrapezium', frequencyHz: 2, duration: 1.3, deltaHz: 0.1 });
   const charts = {};
   for (const id of ['command-zeros-chart', 'response-chart', 'command-chart']) charts[id] = (await canvasInfo(page, id)).hash;
 
@@ -103,7 +104,7 @@ test('a profile picked on the default page: its fields, its zeros, a bad duratio
   assert.equal(await page.$eval('#command-duration', (n) => n.getAttribute('aria-invalid')), 'true');
   for (const [id, hash] of Object.entries(charts)) assert.equal((await canvasInfo(page, id)).hash, hash, `${id} kept`);
   assert.equal(await zerosText(page), text);
-  await type(page, 'command-duration', '1.5');
+  await type(page, 'command-duration', '1.3');
   await settle(page);
   assert.equal(await errorAt(page, 'command-duration'), '');
 
