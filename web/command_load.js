@@ -15,6 +15,7 @@ let draw = null; // the playground module's drawSpectrum, from the last update
 function load() {
   view ??= import(new URL('./command_view.js', import.meta.url).href).then((m) => {
     loaded = m;
+    if (draw) m.update(page.state, draw);
     return m;
   }).catch((e) => {
     view = null;
@@ -33,7 +34,6 @@ export function lazyCommandFields(command, hooks) {
     const c = page.state.view.command;
     if (!m || !LAZY_COMMANDS.includes(c?.kind)) return;
     document.getElementById('command-params').replaceChildren(...m.fields(c, hooks));
-    if (draw) m.update(page.state, draw);
   });
   return [];
 }

@@ -121,6 +121,7 @@ let started = null; // the recording module's instantiation
 let ready = false;
 let latest = null; // the last update's arguments, drawn once the module is there
 let drawnKey = '';
+let drawn = null; // the zeros drawn: { zeros, marked }
 const MAX_MARKED = 12;
 
 /** The view's section, made the first time (after the charts). */
@@ -156,23 +157,26 @@ export function update(state, drawSpectrum) {
   const ratio = window.devicePixelRatio || 1;
   const size = [Math.round(canvas.clientWidth * ratio), Math.round(canvas.clientHeight * ratio)];
   const modes = state.modes.map((m) => m.frequencyHz);
-  const key = JSON.stringify([command, modes, size]);
-  if (key === drawnKey) return;
   const own = [command.frequencyHz + (command.deltaHz || 0), ...(command.modesHz ?? []), command.commonHz];
   const top = 3 * Math.max(...[...modes, ...own].filter((f) => Number.isFinite(f) && f > 0), 1);
-  let u;
-  try {
-    u = profileSpectrum(command, { toHz: top, points: 1200 });
-  } catch {
-    return;
+  // The chart depends on the profile and its range only: a mode edit within the range only
+  // rewrites the line (which modes are on a zero).
+  const key = JSON.stringify([command, top, size]);
+  if (key !== drawnKey) {
+    let u;
+    try {
+      u = profileSpectrum(command, { toHz: top, points: 1200 });
+    } catch {
+      return;
+    }
+    drawnKey = key;
+    drawn = { zeros: u.zeros, marked: u.zeros.filter((z) => !z.finalPulse || z.order > 1).slice(0, MAX_MARKED) };
+    [canvas.width, canvas.height] = size;
+    drawSpectrum(canvas, { frequencyHz: u.frequencyHz, psd: u.magnitude.map((m) => m * m) },
+      { peaksHz: drawn.marked.map((z) => z.frequencyHz), maxHz: top, pixelRatio: ratio, title: 'Profile spectrum |U(f)|² (velocity), its pulses’ zeros marked', yLabel: '|U|² (dB)' });
   }
-  const { zeros } = u;
-  drawnKey = key;
-  [canvas.width, canvas.height] = size;
-  const marked = zeros.filter((z) => !z.finalPulse || z.order > 1).slice(0, MAX_MARKED);
-  drawSpectrum(canvas, { frequencyHz: u.frequencyHz, psd: u.magnitude.map((m) => m * m) },
-    { peaksHz: marked.map((z) => z.frequencyHz), maxHz: top, pixelRatio: ratio, title: 'Profile spectrum |U(f)|² (velocity), its pulses’ zeros marked', yLabel: '|U|² (dB)' });
-  $('command-zeros').textContent = describe(zeros, marked, state.modes, command);
+  const text = describe(drawn.zeros, drawn.marked, state.modes, command);
+  if ($('command-zeros').textContent !== text) $('command-zeros').textContent = text;
 }
 
 /** The zeros in words: each marked one (its order, the mode on it), then the final pulse's. */

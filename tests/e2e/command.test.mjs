@@ -63,6 +63,12 @@ test('the multi-mode profile preset: zeros at k × 1.2 Hz and k × 3.4 Hz, marke
   assert.equal(await page.$eval('#command-modesHz', (n) => n.value), '1.2, 3.4');
   assert.ok(fetched.some((p) => p.endsWith('/pkg/page/command_view.js')), 'the view was fetched');
   await page.screenshot({ path: `${SCREENSHOTS}command-profile-1280x800.png`, fullPage: true });
+  // A mode moved off its zero (the range unchanged): the line says so, the chart stays as drawn.
+  const chart = (await canvasInfo(page, 'command-zeros-chart')).hash;
+  await type(page, 'mode-0-frequency', '1.3');
+  await settle(page);
+  assert.match(await zerosText(page), /1\.2 Hz; 2\.4 Hz;.* Not on a zero: mode 1 \(1\.3 Hz\)\.$/);
+  assert.equal((await canvasInfo(page, 'command-zeros-chart')).hash, chart);
   assert.deepEqual(problems, []);
   await page.close();
 });
