@@ -173,10 +173,23 @@ export function update(state, drawSpectrum) {
     drawn = { zeros: u.zeros, marked: u.zeros.filter((z) => !z.finalPulse || z.order > 1).slice(0, MAX_MARKED) };
     [canvas.width, canvas.height] = size;
     drawSpectrum(canvas, { frequencyHz: u.frequencyHz, psd: u.magnitude.map((m) => m * m) },
-      { peaksHz: drawn.marked.map((z) => z.frequencyHz), maxHz: top, pixelRatio: ratio, title: 'Profile spectrum |U(f)|² (velocity), its pulses’ zeros marked', yLabel: '|U|² (dB)' });
+      { peaksHz: spaced(drawn.marked.map((z) => z.frequencyHz), designed(command), top / 25), maxHz: top, pixelRatio: ratio, title: 'Profile spectrum |U(f)|² (velocity), its pulses’ zeros (spaced labels; all in the line above)', yLabel: '|U|² (dB)' });
   }
   const text = describe(drawn.zeros, drawn.marked, state.modes, command);
   if ($('command-zeros').textContent !== text) $('command-zeros').textContent = text;
+}
+
+/** The frequencies the profile was designed for (its pulses' first zeros). */
+const designed = (c) => [c.frequencyHz, c.frequencyHz - c.deltaHz, c.frequencyHz + c.deltaHz, ...(c.modesHz ?? []), c.commonHz]
+  .filter((f) => Number.isFinite(f) && f > 0);
+
+/** The zeros to label on the chart: those at `first` (the design frequencies) first, then the
+ * others at least `gap` Hz from every one labelled (closer labels overlap; the line lists all). */
+function spaced(zeros, first, gap) {
+  const onMode = (f) => first.some((m) => Math.abs(m - f) <= 1e-6 * f);
+  const out = zeros.filter(onMode);
+  for (const f of zeros) if (!onMode(f) && out.every((g) => Math.abs(g - f) >= gap)) out.push(f);
+  return out.sort((a, b) => a - b);
 }
 
 /** The zeros in words: each marked one (its order, the mode on it), then the final pulse's. */
