@@ -56,7 +56,8 @@ if (process.env.CORNER) {
   state.corner = { open: true, path: 'ringingTower', sideMm: 120, velocity: 100, accel: 3000, scv: 5, magnify: 50, x: [{ frequencyHz: 45, damping: 0.1 }, { frequencyHz: 97, damping: 0.04 }], y: [{ frequencyHz: 38, damping: 0.08 }] };
 }
 const CASES = [[3, 4, 'mode'], [3, 4, 'mismatch'], ...(process.env.CORNER ? [[3, 4, 'corner'], [3, 1, 'corner']] : []), [6, 4, 'mode'], [6, 4, 'mismatch'], [6, 3, 'mode'], [6, 3, 'mismatch'], [3, 1, 'mode'], [3, 1, 'mismatch'],
-  [3, 4, 'mode', 'realised'], [3, 4, 'mismatch', 'realised'], [1, 4, 'mode', 'printer'], [1, 4, 'mismatch', 'printer']]
+  [3, 4, 'mode', 'realised'], [3, 4, 'mismatch', 'realised'], [1, 4, 'mode', 'printer'], [1, 4, 'mismatch', 'printer'],
+  [3, 4, 'mode', 'profile'], [3, 4, 'mismatch', 'profile']]
   .filter(([m, n]) => (!process.env.SHAPERS || Number(process.env.SHAPERS) === n) && (!process.env.MODES || Number(process.env.MODES) === m))
   .filter(([, , , view]) => (process.env.REALISE === 'only' ? view : process.env.REALISE === '0' ? !view : true));
 const SHAPED = {
@@ -66,7 +67,11 @@ const SHAPED = {
   '3,1': '1 shaper (ZVD, 27 impulses)',
   realised: '4 shapers (ZV … ZV-D³) each realised by a generic controller (1 ms, N = 64), the realisation view on screen',
   printer: 'the printer preset (48 Hz; ZV on FT_MOTION, MZV and EI on Klipper, ZVD), the realisation view on screen',
+  profile: '4 shapers (ZV … ZV-D³) shaping a multi-mode profile (1.2, 3.4, 7.9 Hz, 2 s), its spectrum view on screen',
 };
+// Issue 23 item 2's profile view on screen: the command a multi-mode pulse-convolution profile
+// for the three modes; a mode edit redraws its spectrum view (its zeros against the modes).
+const PROFILE = { kind: 'profile', shape: 'multiMode', modesHz: [1.2, 3.4, 7.9], distance: 1, duration: 2 };
 const PRINTER = {
   modes: [{ frequencyHz: 48, damping: 0.07 }],
   shapers: [{ family: 'zv', realise: { firmware: 'marlinFtMotion' } }, { family: 'mzv', realise: { firmware: 'klipper' } },
@@ -178,17 +183,20 @@ async function setCase(p, modes, shapers, view) {
   let s = shapers === 1 ? [{ family: 'zvd' }] : state.shapers.slice(0, shapers);
   if (view === 'realised') s = s.map((x) => ({ ...x, realise: REALISED }));
   if (view === 'printer') ({ modes: m, shapers: s } = PRINTER);
-  const error = await p.evaluate(([m, s]) => {
+  const command = view === 'profile' ? PROFILE : state.view.command;
+  const error = await p.evaluate(([m, s, c]) => {
     const pg = window.__playground;
     pg.state.modes = structuredClone(m);
     pg.state.shapers = structuredClone(s);
+    pg.state.view.command = structuredClone(c);
     pg.state.view.mapShaper = s.length > 1 ? 1 : 0;
     pg.update();
     return [...document.querySelectorAll('.error')].map((x) => x.textContent).filter(Boolean).join('; ');
-  }, [m, s]);
+  }, [m, s, command]);
   if (error) return error;
-  // The realisation view is fetched when first needed and drawn in the next frame.
-  if (view) await p.waitForSelector('#realisation:not([hidden])', { timeout: 20000 });
+  // The realisation and profile views are fetched when first needed and drawn in the next frame.
+  if (view === 'profile') await p.waitForSelector('#command-view:not([hidden])', { timeout: 20000 });
+  else if (view) await p.waitForSelector('#realisation:not([hidden])', { timeout: 20000 });
   else await p.waitForSelector('#realisation[hidden]', { state: 'attached', timeout: 20000 });
   if (process.env.EXPANDED) {
     await p.evaluate(() => document.querySelectorAll('.impulses tfoot:not([hidden]) button[aria-expanded="false"]').forEach((b) => b.click()));

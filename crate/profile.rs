@@ -184,6 +184,77 @@ pub fn from_spec(spec: &ProfileSpec) -> Result<Piecewise> {
     position_from_pulses(&widths, distance)
 }
 
+/// Most zeros [`spectrum_zeros`] lists.
+pub const MAX_ZEROS: usize = 10_000;
+
+/// A frequency where a profile's spectrum is zero.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct SpectrumZero {
+    /// The frequency in Hz.
+    pub frequency_hz: f64,
+    /// How many of the pulses vanish there: the zero's order (2 for the triangle's at f₀, where
+    /// the spectrum is tangent to zero).
+    pub order: usize,
+    /// True when the final pulse (the rest of `duration`) is one of them; a zero of the final
+    /// pulse alone moves with `duration`, not with the modes.
+    pub final_pulse: bool,
+}
+
+/// The zeros of a profile's spectrum |U(f)| (of its velocity, and so of its acceleration) in
+/// (0, `up_to_hz`], in increasing order. Closed form: a unit-area pulse of width w has the
+/// spectrum |sin(πfw)/(πfw)| (Veciana & Cardona 2011 eq. 13, with f₀ = 1/w), zero at f = k/w,
+/// k = 1, 2, …; the velocity is the convolution of the pulses, its spectrum their product
+/// (eqs. 9–12), zero wherever one factor is. Zeros of several pulses within 10⁻⁹ (relative)
+/// are one zero of higher `order`. A zero-width final pulse (a Dirac) has none. Errors: a bad
+/// spec (as [`from_spec`]), `upToHz` not positive, more than [`MAX_ZEROS`] zeros (`tooLarge`).
+pub fn spectrum_zeros(spec: &ProfileSpec, up_to_hz: f64) -> Result<Vec<SpectrumZero>> {
+    // Validated as from_spec validates it (the same errors); the final pulse takes the rest.
+    from_spec(spec)?;
+    let duration = match spec {
+        ProfileSpec::Pulse { duration, .. }
+        | ProfileSpec::Triangle { duration, .. }
+        | ProfileSpec::RobustTrapezium { duration, .. }
+        | ProfileSpec::MultiMode { duration, .. } => *duration,
+    };
+    let mut widths = pulse_durations(spec)?;
+    widths.push((duration - widths.iter().sum::<f64>()).max(0.0));
+    positive("upToHz", up_to_hz)?;
+    let last = widths.len() - 1;
+    let count: f64 = widths.iter().map(|w| (up_to_hz * w).floor()).sum();
+    if count > MAX_ZEROS as f64 {
+        return Err(Error::TooLarge {
+            field: "upToHz".into(),
+            value: count,
+            limit: MAX_ZEROS as f64,
+        });
+    }
+    let mut all: Vec<(f64, bool)> = Vec::with_capacity(count as usize);
+    for (i, &w) in widths.iter().enumerate() {
+        let mut k = 1.0;
+        while w > 0.0 && k / w <= up_to_hz * (1.0 + 1e-12) {
+            all.push((k / w, i == last));
+            k += 1.0;
+        }
+    }
+    all.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut zeros: Vec<SpectrumZero> = Vec::new();
+    for (f, fin) in all {
+        match zeros.last_mut() {
+            Some(z) if (f - z.frequency_hz).abs() <= 1e-9 * f => {
+                z.order += 1;
+                z.final_pulse |= fin;
+            }
+            _ => zeros.push(SpectrumZero {
+                frequency_hz: f,
+                order: 1,
+                final_pulse: fin,
+            }),
+        }
+    }
+    Ok(zeros)
+}
+
 /// The position command whose velocity is the convolution of pulses of the given widths (s),
 /// all of unit area but the product scaled so the move covers `distance`. Zero widths are
 /// Dirac pulses (the identity of convolution). At most [`MAX_PULSES`] non-zero widths.

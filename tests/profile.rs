@@ -7,7 +7,9 @@ mod common;
 use common::close;
 use input_shaping::metrics::mode_residual_percent;
 use input_shaping::plant::ModalPlant;
-use input_shaping::profile::{from_spec, position_from_pulses, to_bspline, ProfileSpec};
+use input_shaping::profile::{
+    from_spec, position_from_pulses, spectrum_zeros, to_bspline, ProfileSpec, SpectrumZero,
+};
 use input_shaping::spectrum::{piecewise_spectrum, SpectrumOptions, SpectrumSignal};
 use input_shaping::{Error, Mode};
 use std::f64::consts::PI;
@@ -385,4 +387,175 @@ fn bad_profiles_are_rejected() {
         position_from_pulses(&[0.1; 9], 1.0).unwrap_err(),
         Error::TooLarge { .. }
     ));
+}
+
+fn zero_hz(z: &[SpectrumZero]) -> Vec<f64> {
+    z.iter().map(|z| z.frequency_hz).collect()
+}
+
+/// `spectrum_zeros` against the paper's closed forms: the pulse's zeros at k·f₀ (eq. 13) and
+/// the final pulse's at k/(t_f − 1/f₀); the triangle's double (tangent) zero at f₀ (eq. 23,
+/// p = 1); the robust trapezium's at f₀ ± Δf (Fig. 8); the multi-mode profile's at each mode
+/// and at every multiple of f_cmd (eq. 28).
+#[wasm_bindgen_test(unsupported = test)]
+fn spectrum_zeros_match_the_papers_closed_forms() {
+    let (f0, tf) = (1.5, 2.2);
+    let pulse = ProfileSpec::Pulse {
+        frequency_hz: f0,
+        distance: 2.0,
+        duration: tf,
+    };
+    let z = spectrum_zeros(&pulse, 5.0).unwrap();
+    let fin = 1.0 / (tf - 1.0 / f0); // 0.652… Hz: 7 zeros below 5 Hz
+    let mut want: Vec<(f64, bool)> = (1..=3).map(|k| (k as f64 * f0, false)).collect();
+    want.extend((1..=7).map(|k| (k as f64 * fin, true)));
+    want.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert_eq!(z.len(), want.len(), "{z:?}");
+    for (z, (f, fp)) in z.iter().zip(&want) {
+        close(z.frequency_hz, *f, 1e-12, "eq. 13 zero");
+        assert_eq!((z.order, z.final_pulse), (1, *fp));
+    }
+    let tri = spectrum_zeros(
+        &ProfileSpec::Triangle {
+            frequency_hz: f0,
+            distance: 1.0,
+            duration: 3.0,
+        },
+        2.0,
+    )
+    .unwrap();
+    // 1.5 Hz twice (tangent), the final pulse (3 − 4/3 s) at 0.6, 1.2 and 1.8 Hz.
+    assert_eq!(
+        tri.iter().map(|z| z.order).collect::<Vec<_>>(),
+        [1, 1, 2, 1]
+    );
+    close(tri[2].frequency_hz, f0, 1e-12, "triangle");
+    close(tri[0].frequency_hz, 0.6, 1e-12, "final pulse");
+    let robust = spectrum_zeros(
+        &ProfileSpec::RobustTrapezium {
+            frequency_hz: f0,
+            delta_hz: 0.2,
+            distance: 1.0,
+            duration: 3.0,
+        },
+        f0 + 0.25,
+    )
+    .unwrap();
+    let design: Vec<f64> = robust
+        .iter()
+        .filter(|z| !z.final_pulse)
+        .map(|z| z.frequency_hz)
+        .collect();
+    assert_eq!(design.len(), 2);
+    close(design[0], f0 - 0.2, 1e-12, "f0 - df");
+    close(design[1], f0 + 0.2, 1e-12, "f0 + df");
+    let multi = spectrum_zeros(
+        &ProfileSpec::MultiMode {
+            modes_hz: vec![1.2, 3.4],
+            common_hz: Some(1.0),
+            distance: 1.0,
+            duration: 4.0,
+        },
+        3.5,
+    )
+    .unwrap();
+    let design = zero_hz(
+        &multi
+            .iter()
+            .filter(|z| !z.final_pulse)
+            .copied()
+            .collect::<Vec<_>>(),
+    );
+    for f in [1.0, 1.2, 2.0, 2.4, 3.0, 3.4] {
+        assert!(
+            design.iter().any(|&g| (g - f).abs() < 1e-12),
+            "{f} Hz in {design:?}"
+        );
+    }
+}
+
+/// Independently of the closed form: the library's spectrum |U(f)| (jump form, quadrature at
+/// low f) is zero at every listed zero, and every dip to zero of |U| on a fine grid is listed.
+#[wasm_bindgen_test(unsupported = test)]
+fn spectrum_zeros_are_the_spectrums_dips() {
+    let specs = [
+        ProfileSpec::Triangle {
+            frequency_hz: 2.0,
+            distance: 1.0,
+            duration: 2.3,
+        },
+        ProfileSpec::RobustTrapezium {
+            frequency_hz: 2.0,
+            delta_hz: 0.3,
+            distance: 1.0,
+            duration: 1.7,
+        },
+        ProfileSpec::MultiMode {
+            modes_hz: vec![1.2, 3.4],
+            common_hz: None,
+            distance: 1.0,
+            duration: 2.0,
+        },
+    ];
+    let top = 8.0;
+    for spec in &specs {
+        let p = from_spec(spec).unwrap();
+        let zeros = zero_hz(&spectrum_zeros(spec, top).unwrap());
+        for &f in &zeros {
+            assert!(velocity_spectrum_at(&p, f) < 1e-9, "{spec:?}: |U({f})|");
+        }
+        let n = 8000;
+        let df = top / n as f64;
+        let u = piecewise_spectrum(
+            &p,
+            &SpectrumOptions {
+                from_hz: df,
+                to_hz: top - df,
+                points: n - 1,
+                signal: SpectrumSignal::Velocity,
+            },
+        )
+        .unwrap();
+        let m = &u.magnitude;
+        let mut dips = 0;
+        for i in 1..m.len() - 1 {
+            if m[i] <= m[i - 1] && m[i] <= m[i + 1] && m[i] < 1e-3 {
+                dips += 1;
+                let f = u.frequency_hz[i];
+                assert!(
+                    zeros.iter().any(|&z| (z - f).abs() <= 2.0 * df),
+                    "{spec:?}: a dip at {f} Hz ({}) not listed in {zeros:?}",
+                    m[i]
+                );
+            }
+        }
+        assert!(dips * 2 >= zeros.len(), "{spec:?}: {dips} dips, {zeros:?}");
+    }
+}
+
+/// Bad arguments of `spectrum_zeros` name their field.
+#[wasm_bindgen_test(unsupported = test)]
+fn bad_zero_requests_are_rejected() {
+    let spec = ProfileSpec::Pulse {
+        frequency_hz: 1.0,
+        distance: 1.0,
+        duration: 2.0,
+    };
+    assert_eq!(
+        spectrum_zeros(&spec, 0.0).unwrap_err().field(),
+        Some("upToHz")
+    );
+    assert!(matches!(
+        spectrum_zeros(&spec, 1e9).unwrap_err(),
+        Error::TooLarge { .. }
+    ));
+    let bad = ProfileSpec::Triangle {
+        frequency_hz: 1.0,
+        distance: 1.0,
+        duration: 1.5,
+    };
+    assert_eq!(
+        spectrum_zeros(&bad, 3.0).unwrap_err().field(),
+        Some("duration")
+    );
 }

@@ -6,6 +6,7 @@ import { page } from './page.js';
 import { MAX_MODES, MAX_SHAPERS } from './state.js';
 import { COMMAND_PARAMS, parseParam, formatParam } from './params.js';
 import { realiseFields } from './realise.js'; // realisation (issue 23, item 1)
+import { LAZY_COMMANDS, lazyCommandFields } from './command_load.js'; // profile and list commands (issue 23 item 2)
 
 // Frequency sliders are logarithmic: 0.01 Hz … 1 kHz over 0 … 1000.
 const F_MIN = 0.01;
@@ -111,9 +112,11 @@ function shaperCard(spec, k) {
     el('span', { class: 'error group-error', role: 'alert' }));
 }
 
-/** The command's parameter fields, for its kind. */
+/** The command's parameter fields, for its kind (a profile's and a list's come with their
+ * view, web/command_view.js, fetched when first needed). */
 export function commandFields() {
   const command = page.state.view.command;
+  if (LAZY_COMMANDS.includes(command.kind)) return lazyCommandFields(command, { field, changed: (c) => page.changed(c) });
   return (COMMAND_PARAMS[command.kind] ?? []).map(([name, label]) => {
     const input = el('input', {
       id: `command-${name}`, type: 'number', step: 'any', inputmode: 'decimal',

@@ -16,6 +16,7 @@ import { page } from './page.js';
 import { rebuild, commandFields, clearErrors, showError } from './editors.js';
 import { showResults, showExport } from './results.js';
 import { updateRealisation, withoutRealise } from './realise.js'; // realisation (issue 23, item 1)
+import { updateCommandView } from './command_load.js'; // profile and list commands (issue 23 item 2)
 import { scheduler, QUIET_MS, designKey, holding, designerError, forgetFailedLoads, requestDesign, pump, compileModule } from './designs.js';
 
 // ---------- update loop ----------
@@ -98,6 +99,7 @@ function update() {
     }
   }
   updateCorner(); // corner (issue 23 item 3): redrawn only when its own inputs changed
+  updateCommandView(page.state, api.drawSpectrum); // a profile's spectrum (issue 23 item 2)
   return performance.now() - t0;
 }
 
@@ -301,7 +303,7 @@ async function main() {
     changed(true);
   });
   $('command-kind').addEventListener('change', () => {
-    page.state.view.command = commandFor($('command-kind').value, page.state.view.command);
+    page.state.view.command = commandFor($('command-kind').value, page.state.view.command, page.state.modes);
     $('command-params').replaceChildren(...commandFields());
     changed(true);
   });

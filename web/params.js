@@ -50,10 +50,20 @@ export const COMMAND_PARAMS = {
     ['maxJerk', 'Max jerk (distance/s³)']],
 };
 
-/** A command of `kind` keeping what it shares with `previous` (limits default to a 1-unit move). */
-export function commandFor(kind, previous = {}) {
+/** A command of `kind` keeping what it shares with `previous` (limits default to a 1-unit move;
+ * a profile is Veciana & Cardona's triangle for the first of `modes`, lasting 2.6 of its periods
+ * (its final pulse's zeros then fall off the triangle's);
+ * a list a made-up joystick trace, 0.05 s apart). */
+export function commandFor(kind, previous = {}, modes = []) {
   const distance = Number.isFinite(previous.distance) ? previous.distance : 1;
   const next = { kind, distance };
+  if (kind === 'profile') {
+    const f = modes[0]?.frequencyHz > 0 ? modes[0].frequencyHz : 1;
+    return { ...next, shape: 'triangle', frequencyHz: f, duration: Number((2.6 / f).toPrecision(3)) };
+  }
+  if (kind === 'sampled') {
+    return { kind, samplePeriod: 0.05, values: [0, 0.1, 0.3, 0.6, 0.8, 0.9, 1, 1, 1, 0.9, 0.7, 0.6, 0.6].map((v) => v * distance), interpolation: 'linear' };
+  }
   if (kind === 'trapezoid' || kind === 'sCurve') {
     next.maxVelocity = Number.isFinite(previous.maxVelocity) ? previous.maxVelocity : Math.abs(distance) || 1;
     next.maxAcceleration = Number.isFinite(previous.maxAcceleration) ? previous.maxAcceleration : 10 * next.maxVelocity;

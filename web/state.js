@@ -7,7 +7,11 @@
 //   view:    { vtol, scv,                        analysis
 //              mismatch,                         simulation: actual frequency = model × mismatch
 //              command: { kind: 'step' | 'trapezoid' | 'sCurve', distance, maxVelocity?,
-//                         maxAcceleration?, maxJerk? },
+//                         maxAcceleration?, maxJerk? }
+//                     | { kind: 'profile', shape, frequencyHz? | modesHz?, deltaHz?, commonHz?,
+//                         distance, duration }         Veciana & Cardona's profiles
+//                     | { kind: 'sampled', samplePeriod, values: [], interpolation }
+//                                                      a list (web/command_view.js),
 //              plant: { kind: 'modal' } | { kind: 'pendulum', gravity?, initialAngle? },
 //              mapShaper }                       which shaper the frequency × damping map shows
 //   corner?: { open, path: 'square' | 'ringingTower', sideMm, velocity, accel, scv, magnify,
@@ -17,7 +21,7 @@
 export const MAX_MODES = 6;
 export const MAX_SHAPERS = 4;
 
-export const COMMAND_KINDS = ['step', 'trapezoid', 'sCurve'];
+export const COMMAND_KINDS = ['step', 'trapezoid', 'sCurve', 'profile', 'sampled'];
 export const PLANT_KINDS = ['modal', 'pendulum'];
 
 /** A view with the simulation defaults and the given command. */
@@ -93,6 +97,19 @@ export const PRESETS = [
       view: view(trapezoid(4, 1, 2), { plant: { kind: 'pendulum', gravity: 9.81, initialAngle: 0 } }),
     },
   },
+  // ---- command presets (issue 23 item 2): web/command_view.js ----
+  {
+    id: 'veciana-profile',
+    title: 'Veciana & Cardona 2011: a multi-mode pulse-convolution profile for 1.2 Hz and 3.4 Hz (zeros at both modes)',
+    state: {
+      // §2.4, Fig. 10: one pulse of 1/1.2 s and one of 1/3.4 s, and a final pulse to 2 s; the
+      // unshaped profile leaves no vibration at either (undamped) mode. The shapers shape it again.
+      modes: [{ frequencyHz: 1.2, damping: 0.012 }, { frequencyHz: 3.4, damping: 0.013 }],
+      shapers: [{ family: 'zv' }, { family: 'zvd' }],
+      view: view({ kind: 'profile', shape: 'multiMode', modesHz: [1.2, 3.4], distance: 0.5, duration: 2 }),
+    },
+  },
+  // ---- end of the command presets ----
   // ---- printer preset (issue 23): realisation (item 1) ----
   {
     id: 'printer',
@@ -201,7 +218,11 @@ function checkView(view, fail) {
     } else if (k === 'command') {
       if (!plain(v) || !COMMAND_KINDS.includes(v.kind)) fail(`view.command must be { kind: ${COMMAND_KINDS.join(' | ')}, … }`);
       for (const [ck, cv] of Object.entries(v)) {
-        if (ck !== 'kind' && !num(cv)) fail(`view.command.${ck} must be a number`);
+        // A profile's shape and a list's interpolation are names, its values / modesHz lists
+        // (the core judges them all and names the field).
+        const ok = ck === 'kind' || num(cv) || (typeof cv === 'string' && cv.length <= 40)
+          || (Array.isArray(cv) && cv.every(num));
+        if (!ok) fail(`view.command.${ck} must be a number, a name or a list of numbers`);
       }
     } else if (k === 'plant') {
       if (!plain(v) || !PLANT_KINDS.includes(v.kind)) fail(`view.plant must be { kind: ${PLANT_KINDS.join(' | ')} }`);

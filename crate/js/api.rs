@@ -457,6 +457,61 @@ pub fn spectrum(
     to_js(&result)
 }
 
+/// A profile's spectrum and its zeros (`profileSpectrum`).
+#[cfg(any(feature = "js-api", feature = "js-recording"))]
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct ProfileSpectrum {
+    frequency_hz: Vec<f64>,
+    magnitude: Vec<f64>,
+    zeros: Vec<crate::profile::SpectrumZero>,
+}
+
+/// `profileSpectrum(command, { fromHz?, toHz, points?, signal? })` → `{ frequencyHz, magnitude,
+/// zeros: [{ frequencyHz, order, finalPulse }] }`: |U(f)| of a pulse-convolution profile
+/// (`command = { kind: "profile", shape, … }`; as `spectrum` computes it, of the velocity by
+/// default) and the frequencies in (0, toHz] where it is zero, in closed form
+/// (crate::profile::spectrum_zeros: Veciana & Cardona 2011 eq. 13 for each pulse, their product
+/// by eqs. 9–12); `order` counts the pulses vanishing there, `finalPulse` says the final pulse
+/// is one of them. Errors name `command.<field>` (another kind: `command.kind`) or
+/// `options.<field>`. Also in the page's lazily fetched module (`js-recording`), for its
+/// profile view (web/command_view.js).
+#[cfg(any(feature = "js-api", feature = "js-recording"))]
+#[wasm_bindgen(js_name = profileSpectrum, unchecked_return_type = "ProfileSpectrum")]
+pub fn profile_spectrum(
+    #[wasm_bindgen(unchecked_param_type = "CommandSpec")] command: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "SpectrumOptions")] options: JsValue,
+) -> Result<JsValue, JsValue> {
+    let spec: crate::command::CommandSpec = from_js(command, "command").map_err(js_error)?;
+    let crate::command::CommandSpec::Profile(profile) = spec else {
+        return Err(js_error(Error::invalid(
+            "command.kind",
+            "the spectrum zeros are known in closed form for a profile command only (kind: \"profile\")",
+        )));
+    };
+    let options: crate::spectrum::SpectrumOptions =
+        from_js(options, "options").map_err(js_error)?;
+    let position =
+        crate::profile::from_spec(&profile).map_err(|e| js_error(e.within("command")))?;
+    let u = crate::spectrum::piecewise_spectrum(&position, &options)
+        .map_err(|e| js_error(e.within("options")))?;
+    let zeros = crate::profile::spectrum_zeros(&profile, options.to_hz).map_err(|e| {
+        js_error(match e {
+            Error::TooLarge { value, limit, .. } => Error::TooLarge {
+                field: "options.toHz".into(),
+                value,
+                limit,
+            },
+            e => e.within("command"),
+        })
+    })?;
+    to_js(&ProfileSpectrum {
+        frequency_hz: u.frequency_hz,
+        magnitude: u.magnitude,
+        zeros,
+    })
+}
+
 /// `simulateCorner(spec)`: `spec = { path: { kind: "square", sideMm } | { kind:
 /// "ringingTower", sideMm?, thicknessMm? }, velocity, accel, squareCornerVelocity?, x: { modes,
 /// shaper? | impulses? }, y: (same), samplePeriodS?, settleS?, magnify? }` → `{ segments,

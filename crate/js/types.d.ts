@@ -414,6 +414,30 @@ export interface SpectrumResult {
   modesHz: number[];
 }
 
+/** A zero of a profile's spectrum (`profileSpectrum`). */
+export interface ProfileZero {
+  frequencyHz: number;
+  /** How many pulses vanish there (2: a tangent zero). */
+  order: number;
+  /** The final pulse (the rest of `duration`) is one of them. */
+  finalPulse: boolean;
+}
+
+/** The frequencies of `profileSpectrum`. */
+export interface SpectrumOptions {
+  fromHz?: number;
+  toHz: number;
+  points?: number;
+  signal?: "position" | "velocity" | "acceleration";
+}
+
+/** `profileSpectrum`'s result: |U(f)| of the profile and its zeros up to `toHz`. */
+export interface ProfileSpectrum {
+  frequencyHz: number[];
+  magnitude: number[];
+  zeros: ProfileZero[];
+}
+
 // ---------------------------------------------------------------------------------------------
 // The printed corner (simulateCorner)
 

@@ -19,6 +19,7 @@ import init, {
   realizeShaper,
   simulate,
   spectrum,
+  profileSpectrum,
   simulateCorner,
   renderCorner,
   renderPlayground,
@@ -122,6 +123,9 @@ export async function main(canvas: HTMLCanvasElement): Promise<void> {
   });
   const swing: number[] | undefined = crane.unshaped.swingAngle;
   const u = spectrum({ command: { kind: "step" }, shaper: { family: "zv", modes: [mode] }, toHz: 10 });
+  const ps = profileSpectrum({ kind: "profile", shape: "pulse", frequencyHz: 2, distance: 1, duration: 1 }, { toHz: 10 });
+  const firstZero: number = ps.zeros[0].frequencyHz + ps.zeros[0].order + (ps.zeros[0].finalPulse ? 1 : 0) + ps.magnitude[0];
+  void firstZero;
   console.log(residual, swing, u.magnitude[0]);
 
   // The printed corner: a path discriminated by `kind`, each axis with its modes and shaper.

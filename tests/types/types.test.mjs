@@ -190,6 +190,7 @@ function calls(exports) {
   add('SimulationResult', api.simulate({ plant: { kind: 'vecianaTestBed' }, command: { kind: 'sampled', samplePeriod: 0.1, values: [0, 0.5, 1, 1], interpolation: 'hold' }, shaper: { family: 'zv', modes: [{ frequencyHz: 1.2 }] }, duration: 2, samplePeriod: 0.05 }));
   add('SpectrumResult', api.spectrum({ command: { kind: 'ramp', slope: 1 }, shaper: { family: 'zv', modes: [mode] }, toHz: 10, points: 4, signal: 'position' }));
   add('SpectrumResult', api.spectrum({ command: { kind: 'step' }, plant: modal, points: 3 }));
+  add('ProfileSpectrum', api.profileSpectrum({ kind: 'profile', shape: 'robustTrapezium', frequencyHz: 2, deltaHz: 0.2, distance: 1, duration: 2 }, { toHz: 5, points: 3 }));
   add('CornerResult', api.simulateCorner({ path: { kind: 'square', sideMm: 5 }, velocity: 50, accel: 2000, x: { modes: [{ frequencyHz: 40 }], shaper: { family: 'zv' } }, y: { modes: [{ frequencyHz: 50, damping: 0.1 }] }, samplePeriodS: 0.01, magnify: 10 }));
   add('CornerResult', api.simulateCorner({ path: { kind: 'ringingTower', sideMm: 20, thicknessMm: 2 }, velocity: 50, accel: 2000, squareCornerVelocity: 0, x: { modes: [{ frequencyHz: 40 }] }, y: { modes: [{ frequencyHz: 50 }] }, samplePeriodS: 0.01, settleS: 0 }));
   add('PlaygroundResult', api.renderPlayground({
