@@ -331,8 +331,9 @@ const SCAN_CHUNK: usize = 256;
 /// # Ok::<(), input_shaping::Error>(())
 /// ```
 pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensitivity> {
-    tolerable_vibration(vtol)?;
-    Ok(BandScan::new(shaper, mode.damping(), vtol, true).band(mode.frequency_hz()))
+    // One mode's joint scan is its own (one code path in the page's module).
+    let bands = insensitivities(shaper, std::slice::from_ref(mode), vtol)?;
+    Ok(bands[0])
 }
 
 /// [`insensitivity`] as it was computed before the decay bound: every upper edge scanned to its
@@ -354,35 +355,24 @@ pub fn insensitivity_full_scan(shaper: &Shaper, mode: &Mode, vtol: f64) -> Resul
 /// The same bands as [`insensitivity`] mode by mode, up to the refinement's last bits (tested).
 pub fn insensitivities(shaper: &Shaper, modes: &[Mode], vtol: f64) -> Result<Vec<Insensitivity>> {
     tolerable_vibration(vtol)?;
-    let mut scans: Vec<BandScan> = Vec::new();
-    let mut done: Vec<(f64, f64, Insensitivity)> = Vec::with_capacity(modes.len());
-    for mode in modes {
+    let mut bands: Vec<Insensitivity> = Vec::with_capacity(modes.len());
+    for (j, mode) in modes.iter().enumerate() {
         let (f_m, zeta) = (mode.frequency_hz(), mode.damping());
-        let k = match scans
-            .iter()
-            .position(|s| s.zeta.to_bits() == zeta.to_bits())
-        {
-            Some(k) => k,
-            None => {
-                scans.push(BandScan::new(shaper, zeta, vtol, true));
-                scans.len() - 1
-            }
-        };
-        let scan = &scans[k];
+        let scan = BandScan::new(shaper, zeta, vtol, true);
         // Only scans at their resolved steps are shared: a scan coarsened to bound its work
         // may step over a crossing that another mode's grid sees, and each mode's band must
         // stay the one its own scan finds.
-        let shared = done.iter().find(|(z, f_i, b)| {
-            z.to_bits() == zeta.to_bits()
+        let shared = modes[..j].iter().zip(&bands).find(|(other, b)| {
+            other.damping() == zeta
                 && b.low_hz < f_m
                 && f_m < b.high_hz
-                && *f_i != f_m
-                && scan.resolved(*f_i)
+                && scan.resolved(other.frequency_hz())
                 && scan.resolved(f_m)
         });
         let band = match shared {
-            Some(&(_, f_i, b)) if scan.excess(f_m) <= 0.0 => {
-                let (limit_i, limit) = (f_i * MAX_BAND_RATIO, f_m * MAX_BAND_RATIO);
+            Some((other, b)) if scan.excess(f_m) <= 0.0 => {
+                let (limit_i, limit) =
+                    (other.frequency_hz() * MAX_BAND_RATIO, f_m * MAX_BAND_RATIO);
                 let high_hz = if b.high_hz < limit_i || limit <= limit_i {
                     // A crossing above both modes, or this mode's limit inside the band.
                     b.high_hz.min(limit)
@@ -397,9 +387,9 @@ pub fn insensitivities(shaper: &Shaper, modes: &[Mode], vtol: f64) -> Result<Vec
             }
             _ => scan.band(f_m),
         };
-        done.push((zeta, f_m, band));
+        bands.push(band);
     }
-    Ok(done.into_iter().map(|(_, _, b)| b).collect())
+    Ok(bands)
 }
 
 /// The scan of [`insensitivity`]'s band edges for one shaper, damping ratio and Vtol.
@@ -494,7 +484,9 @@ impl<'a> BandScan<'a> {
     }
 
     /// The band's edge from `start` (inside) towards `limit` for the mode at `f_m`: the first
-    /// crossing, refined, or `limit`.
+    /// crossing, refined, or `limit`. Out of line: called from two places, inlined it costs the
+    /// page's module its size twice.
+    #[inline(never)]
     fn edge(&self, f_m: f64, start: f64, direction: f64, limit: f64) -> f64 {
         let excess = |f: f64| self.excess(f);
         // V oscillates in f with period ~1/duration; sample it at least 40 times per period, but
