@@ -351,3 +351,34 @@ fn bands_scanned_jointly_are_each_modes_own() {
     }
     assert!(shared >= 20, "{shared} bands holding another mode");
 }
+
+#[test]
+fn the_wire_form_of_a_factored_shaper_carries_its_factors() {
+    // `factors` is written only for a factored shaper: the per-mode ZV-D³ shapers, whose
+    // convolution is `impulses`; read back, it is ignored.
+    let modes = six_modes();
+    let shaper = design_for(&ShaperSpec::Zvdn { derivatives: 3 }, &modes).unwrap();
+    let json = serde_json::to_value(shaper.to_data()).unwrap();
+    let factors: Vec<Vec<Impulse>> = serde_json::from_value(json["factors"].clone()).unwrap();
+    assert_eq!(factors.len(), 6);
+    for (f, m) in factors.iter().zip(&modes) {
+        assert_eq!(f, zv_dn(m, 3).unwrap().impulses());
+    }
+    let convolved = factors[1..]
+        .iter()
+        .map(|f| Shaper::new(f.clone()).unwrap())
+        .try_fold(Shaper::new(factors[0].clone()).unwrap(), |a, f| {
+            a.convolve_factored(&f)
+        })
+        .unwrap();
+    let impulses: Vec<Impulse> = serde_json::from_value(json["impulses"].clone()).unwrap();
+    assert_eq!(convolved.impulses(), &impulses[..]);
+    let back: input_shaping::shaper::ShaperData = serde_json::from_value(json).unwrap();
+    assert!(back.factors.is_none() && back.impulses == impulses);
+    // A shaper formed from its impulses has none.
+    let zvd = design_for(&ShaperSpec::Zvd, &modes[..3]).unwrap();
+    assert!(serde_json::to_value(zvd.to_data())
+        .unwrap()
+        .get("factors")
+        .is_none());
+}
