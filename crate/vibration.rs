@@ -398,31 +398,17 @@ struct BandScan<'a> {
     zeta: f64,
     /// Vtol with its slack: V above this is outside the band.
     threshold: f64,
-    /// Per factor, (|Aᵢ|, t_n − tᵢ) of each impulse: the decay bound's terms; empty when the
-    /// bound is not used (no damping, or the full scan).
-    decay: Vec<Vec<(f64, f64)>>,
+    /// Whether the upper scans may end on the decay bound (damping, and not the full scan).
+    bounded: bool,
 }
 
 impl<'a> BandScan<'a> {
     fn new(shaper: &'a Shaper, zeta: f64, vtol: f64, bounded: bool) -> Self {
-        let decay = if bounded && zeta > 0.0 {
-            shaper
-                .factors()
-                .map(|f| {
-                    let t_n = f.last().map_or(0.0, |imp| imp.time);
-                    f.iter()
-                        .map(|imp| (imp.amplitude.abs(), t_n - imp.time))
-                        .collect()
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
         BandScan {
             shaper,
             zeta,
             threshold: vtol * (1.0 + VTOL_SLACK) + 1e-14,
-            decay,
+            bounded: bounded && zeta > 0.0,
         }
     }
 
@@ -435,14 +421,19 @@ impl<'a> BandScan<'a> {
     /// Σ|Aᵢ| e^{−ζω(t_n − tᵢ)} (each factor's |W| at ω and above, since the terms only decay as
     /// ω grows) is under it, with room for rounding.
     fn under_for_good(&self, f: f64) -> bool {
-        if self.decay.is_empty() {
+        if !self.bounded {
             return false;
         }
         let zw = self.zeta * 2.0 * std::f64::consts::PI * f;
         let bound: f64 = self
-            .decay
-            .iter()
-            .map(|terms| terms.iter().map(|&(a, d)| a * (-zw * d).exp()).sum::<f64>())
+            .shaper
+            .factors()
+            .map(|imps| {
+                let t_n = imps.last().map_or(0.0, |imp| imp.time);
+                imps.iter()
+                    .map(|imp| imp.amplitude.abs() * (-zw * (t_n - imp.time)).exp())
+                    .sum::<f64>()
+            })
             .product();
         bound * (1.0 + 1e-12) <= self.threshold
     }
