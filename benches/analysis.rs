@@ -10,9 +10,11 @@
 mod native {
     use criterion::Criterion;
     use input_shaping::design::zero_vibration::zvd;
+    use input_shaping::design::{design_for, ShaperSpec};
     use input_shaping::vibration::{
-        damping_sensitivity, sensitivity, sensitivity_map, vibration_rad,
-        DampingSensitivityOptions, SensitivityMapOptions, SensitivityOptions,
+        damping_sensitivity, insensitivities, insensitivity, insensitivity_full_scan, sensitivity,
+        sensitivity_map, vibration_rad, DampingSensitivityOptions, SensitivityMapOptions,
+        SensitivityOptions,
     };
     use input_shaping::{Mode, Shaper};
     use std::hint::black_box;
@@ -102,6 +104,45 @@ mod native {
         c.bench_function("damping_sensitivity 1000 points, 9 impulses", |b| {
             b.iter(|| damping_sensitivity(black_box(&shaper), black_box(&damping)))
         });
+        insensitivity_six_modes(c);
+    }
+
+    /// I(Vtol 5 %) at issue 24's six modes (1.2 … 34 Hz, ζ 0.02) of the page's four convolved
+    /// shapers: the full scan each mode (the path before the decay bound), the bounded scan each
+    /// mode, and the six bands scanned jointly (what the page calls).
+    fn insensitivity_six_modes(c: &mut Criterion) {
+        let modes: Vec<Mode> = [1.2, 3.4, 7.9, 13.0, 21.0, 34.0]
+            .iter()
+            .map(|&f| Mode::new(f, 0.02).expect("valid mode"))
+            .collect();
+        let specs = [
+            ("ZV", ShaperSpec::Zv),
+            ("ZVD", ShaperSpec::Zvd),
+            ("ZVDD", ShaperSpec::Zvdd),
+            ("ZV-D3", ShaperSpec::Zvdn { derivatives: 3 }),
+        ];
+        for (name, spec) in specs {
+            let shaper = design_for(&spec, &modes).expect("six-mode design");
+            c.bench_function(&format!("I(Vtol) six modes {name}, full scan"), |b| {
+                b.iter(|| {
+                    modes
+                        .iter()
+                        .map(|m| insensitivity_full_scan(black_box(&shaper), m, 0.05))
+                        .collect::<Vec<_>>()
+                })
+            });
+            c.bench_function(&format!("I(Vtol) six modes {name}, bounded"), |b| {
+                b.iter(|| {
+                    modes
+                        .iter()
+                        .map(|m| insensitivity(black_box(&shaper), m, 0.05))
+                        .collect::<Vec<_>>()
+                })
+            });
+            c.bench_function(&format!("I(Vtol) six modes {name}, joint"), |b| {
+                b.iter(|| insensitivities(black_box(&shaper), &modes, 0.05))
+            });
+        }
     }
 
     /// The criterion group, configured for a shared machine (1 s warm-up, 3 s measurement).

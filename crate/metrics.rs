@@ -184,8 +184,21 @@ pub fn mode_residual_percent(plant: &ModalPlant, command: &Piecewise) -> Result<
 /// at [`PER_PIECE`] + 1 points, and its final value. Where that derivative is linear on every
 /// piece (`order` ≥ degree − 1: the acceleration of trapezoids and S-curves, shaped or not),
 /// each piece is monotone and only its two ends are sampled: the interior points could not
-/// change the peak |value| or the turning points [`peak_valley_count`] finds.
+/// change the peak |value| or the turning points [`peak_valley_count`] finds. Where it is
+/// constant on every piece (`order` ≥ degree: a trapezoid's acceleration), one value per piece:
+/// both ends would be the same number (the Taylor shift of order 0 adds nothing to it), and a
+/// repeated value changes neither the peak nor [`peak_valley_count`].
 fn sample_derivative(p: &Piecewise, order: usize) -> Vec<f64> {
+    if p.degree() <= order {
+        let mut out = Vec::with_capacity(p.knots().len() + 1);
+        out.push(0.0);
+        let mut cursor = Cursor::new(p);
+        for k in p.knots() {
+            cursor.seek(k.time);
+            out.push(cursor.state_at(k.time)[order]);
+        }
+        return out;
+    }
     let per_piece = if p.degree() <= order + 1 {
         1
     } else {

@@ -62,8 +62,9 @@ impl PartialEq for Shaper {
     }
 }
 
-/// The wire form of a shaper: `{ impulses: [{ time, amplitude }], duration }`. `duration` is
-/// written for convenience and ignored when read.
+/// The wire form of a shaper: `{ impulses: [{ time, amplitude }], duration }`, plus
+/// `factors` for a factored shaper (see [`Shaper`]). `duration` and `factors` are written for
+/// convenience and ignored when read.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ShaperData {
     /// The impulses, sorted by time, first at 0.
@@ -71,6 +72,10 @@ pub struct ShaperData {
     /// Time of the last impulse in seconds.
     #[serde(default)]
     pub duration: f64,
+    /// For a convolution kept factored (more than [`MAX_IMPULSES`] impulses): its factors'
+    /// impulses, each a shaper's, whose convolution `impulses` is. Absent otherwise.
+    #[serde(default, skip_deserializing, skip_serializing_if = "Option::is_none")]
+    pub factors: Option<Vec<Vec<Impulse>>>,
 }
 
 /// Whether `impulses` is the identity (one unit impulse), which a convolution leaves out.
@@ -203,6 +208,7 @@ impl Shaper {
         ShaperData {
             impulses: self.impulses().to_vec(),
             duration: self.duration(),
+            factors: self.factored.then(|| self.factors.clone()),
         }
     }
 

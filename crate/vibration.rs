@@ -314,6 +314,12 @@ const SCAN_CHUNK: usize = 256;
 /// machine precision by the ITP method (Oliveira & Takahashi 2020: about 10 evaluations of
 /// eq. 11 per edge, never more than bisection + 3).
 ///
+/// The upper edge's scan stops early where V is bounded below Vtol for good: with damping,
+/// |W| ≤ Σ|Aᵢ| e^{−ζω(t_n − tᵢ)}, which only falls as ω grows, so once the product of the
+/// factors' bounds is under Vtol no frequency above can leave the band (a product of six
+/// factors gets there within tens of hertz, where a scan to 50 × f took ~10⁵ points). The
+/// result is [`insensitivity_full_scan`]'s bit for bit: its scan would find nothing there.
+///
 /// ```
 /// use input_shaping::{design::zero_vibration::zv, vibration::insensitivity, Mode};
 /// // Undamped ZV: V = |cos(πr/2)| ≤ Vtol for |r − 1| ≤ 2·asin(Vtol)/π, so I = 4·asin(Vtol)/π.
@@ -325,39 +331,170 @@ const SCAN_CHUNK: usize = 256;
 /// # Ok::<(), input_shaping::Error>(())
 /// ```
 pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensitivity> {
+    // One mode's joint scan is its own (one code path in the page's module).
+    let bands = insensitivities(shaper, std::slice::from_ref(mode), vtol)?;
+    Ok(bands[0])
+}
+
+/// [`insensitivity`] as it was computed before the decay bound: every upper edge scanned to its
+/// crossing or to 50 × f. Kept as the reference the faster scans are tested against
+/// (`tests/factored.rs`) and for benchmarks; the same band, slower.
+pub fn insensitivity_full_scan(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensitivity> {
     tolerable_vibration(vtol)?;
-    let f_m = mode.frequency_hz();
-    let zeta = mode.damping();
-    let threshold = vtol * (1.0 + VTOL_SLACK) + 1e-14;
-    let excess =
-        |f: f64| shaper_vibration(shaper, 2.0 * std::f64::consts::PI * f, zeta) - threshold;
-    if excess(f_m) > 0.0 {
-        return Ok(Insensitivity {
-            low_hz: f_m,
-            high_hz: f_m,
-            width: 0.0,
+    Ok(BandScan::new(shaper, mode.damping(), vtol, false).band(mode.frequency_hz()))
+}
+
+/// [`insensitivity`] at each of `modes`, the bands scanned jointly: the band around a mode is
+/// the connected part of {f : V(f) ≤ Vtol} holding it, so a mode inside a band already traced
+/// at the same damping has that band — its lower edge, and its upper edge up to its own limit of
+/// 50 × f (the scan resumes from the other mode's limit when that was reached). A product of
+/// factors often stays under Vtol across several modes (issue 24's six modes: one band from
+/// ~2.3 Hz up for modes 2 … 6), which each mode's own scan would walk again. A band is shared
+/// only between modes whose own scans are fine enough to see every crossing (40 points per
+/// period of V's oscillation, not coarsened by the work bound); the others are scanned alone.
+/// The same bands as [`insensitivity`] mode by mode, up to the refinement's last bits (tested).
+pub fn insensitivities(shaper: &Shaper, modes: &[Mode], vtol: f64) -> Result<Vec<Insensitivity>> {
+    tolerable_vibration(vtol)?;
+    let mut bands: Vec<Insensitivity> = Vec::with_capacity(modes.len());
+    for (j, mode) in modes.iter().enumerate() {
+        let (f_m, zeta) = (mode.frequency_hz(), mode.damping());
+        let scan = BandScan::new(shaper, zeta, vtol, true);
+        // Only scans at their resolved steps are shared: a scan coarsened to bound its work
+        // may step over a crossing that another mode's grid sees, and each mode's band must
+        // stay the one its own scan finds.
+        let shared = modes[..j].iter().zip(&bands).find(|(other, b)| {
+            other.damping() == zeta
+                && b.low_hz < f_m
+                && f_m < b.high_hz
+                && scan.resolved(other.frequency_hz())
+                && scan.resolved(f_m)
         });
+        let band = match shared {
+            Some((other, b)) if scan.excess(f_m) <= 0.0 => {
+                let (limit_i, limit) =
+                    (other.frequency_hz() * MAX_BAND_RATIO, f_m * MAX_BAND_RATIO);
+                let high_hz = if b.high_hz < limit_i || limit <= limit_i {
+                    // A crossing above both modes, or this mode's limit inside the band.
+                    b.high_hz.min(limit)
+                } else {
+                    scan.edge(f_m, limit_i, 1.0, limit)
+                };
+                Insensitivity {
+                    low_hz: b.low_hz,
+                    high_hz,
+                    width: (high_hz - b.low_hz) / f_m,
+                }
+            }
+            _ => scan.band(f_m),
+        };
+        bands.push(band);
     }
-    // V oscillates in f with period ~1/duration; sample it at least 40 times per period, but
-    // spend at most MAX_SCAN_WORK impulse-evaluations per side (coarser beyond that). The
-    // impulses counted are the expanded shaper's (Π nₖ for a factored one), as before
-    // shapers were kept factored, though a convolution is evaluated from its Σ nₖ factor
-    // impulses: counting those instead (a finer step, the same work bound) made I(Vtol) at
-    // issue 24's six modes take 70 ms for ZVDD and 87 ms for ZV-D³ natively (2026-12-04,
-    // docs/page-performance.md), the bands of modes 2 … 6 reaching their 50 × f limits.
-    let per_period = 1.0 / (40.0 * shaper.duration().max(f64::MIN_POSITIVE));
-    let work_step = |span: f64| span * shaper.expanded_len() as f64 / MAX_SCAN_WORK;
-    let mut values = Vec::with_capacity(SCAN_CHUNK);
-    let mut edge = |direction: f64, limit: f64| -> f64 {
+    Ok(bands)
+}
+
+/// The scan of [`insensitivity`]'s band edges for one shaper, damping ratio and Vtol.
+struct BandScan<'a> {
+    shaper: &'a Shaper,
+    zeta: f64,
+    /// Vtol with its slack: V above this is outside the band.
+    threshold: f64,
+    /// Whether the upper scans may end on the decay bound (damping, and not the full scan).
+    bounded: bool,
+}
+
+impl<'a> BandScan<'a> {
+    fn new(shaper: &'a Shaper, zeta: f64, vtol: f64, bounded: bool) -> Self {
+        BandScan {
+            shaper,
+            zeta,
+            threshold: vtol * (1.0 + VTOL_SLACK) + 1e-14,
+            bounded: bounded && zeta > 0.0,
+        }
+    }
+
+    /// V(f) − threshold.
+    fn excess(&self, f: f64) -> f64 {
+        shaper_vibration(self.shaper, 2.0 * std::f64::consts::PI * f, self.zeta) - self.threshold
+    }
+
+    /// Whether V ≤ threshold at every frequency ≥ `f`: Π over the factors of
+    /// Σ|Aᵢ| e^{−ζω(t_n − tᵢ)} (each factor's |W| at ω and above, since the terms only decay as
+    /// ω grows) is under it, with room for rounding.
+    fn under_for_good(&self, f: f64) -> bool {
+        if !self.bounded {
+            return false;
+        }
+        let zw = self.zeta * 2.0 * std::f64::consts::PI * f;
+        let bound: f64 = self
+            .shaper
+            .factors()
+            .map(|imps| {
+                let t_n = imps.last().map_or(0.0, |imp| imp.time);
+                imps.iter()
+                    .map(|imp| imp.amplitude.abs() * (-zw * (t_n - imp.time)).exp())
+                    .sum::<f64>()
+            })
+            .product();
+        bound * (1.0 + 1e-12) <= self.threshold
+    }
+
+    /// The band around `f_m`.
+    fn band(&self, f_m: f64) -> Insensitivity {
+        if self.excess(f_m) > 0.0 {
+            return Insensitivity {
+                low_hz: f_m,
+                high_hz: f_m,
+                width: 0.0,
+            };
+        }
+        let high_hz = self.edge(f_m, f_m, 1.0, f_m * MAX_BAND_RATIO);
+        let low_hz = self.edge(f_m, f_m, -1.0, 0.0);
+        Insensitivity {
+            low_hz,
+            high_hz,
+            width: (high_hz - low_hz) / f_m,
+        }
+    }
+
+    /// The step of the scan from the mode at `f_m` towards `limit`, and whether it is the
+    /// resolved one (at least 40 points per period of V's oscillation and 400 per f_m, not
+    /// coarsened to bound the work).
+    fn step(&self, f_m: f64, limit: f64) -> (f64, bool) {
+        let per_period = 1.0 / (40.0 * self.shaper.duration().max(f64::MIN_POSITIVE));
         let span = (limit - f_m).abs();
-        let step = (0.0025 * f_m)
-            .min(per_period)
-            .max(work_step(span))
+        let resolved = (0.0025 * f_m).min(per_period);
+        let step = resolved
+            .max(span * self.shaper.expanded_len() as f64 / MAX_SCAN_WORK)
             .max(span / 2e6);
-        let h = direction * step;
-        let mut rows = Rows::new(shaper, h);
-        let mut inside = f_m;
+        (step, step == resolved)
+    }
+
+    /// Whether both of the scans of the band around `f_m` run at their resolved steps.
+    fn resolved(&self, f_m: f64) -> bool {
+        self.step(f_m, f_m * MAX_BAND_RATIO).1 && self.step(f_m, 0.0).1
+    }
+
+    /// The band's edge from `start` (inside) towards `limit` for the mode at `f_m`: the first
+    /// crossing, refined, or `limit`. Out of line: called from two places, inlined it costs the
+    /// page's module its size twice.
+    #[inline(never)]
+    fn edge(&self, f_m: f64, start: f64, direction: f64, limit: f64) -> f64 {
+        let excess = |f: f64| self.excess(f);
+        // V oscillates in f with period ~1/duration; sample it at least 40 times per period, but
+        // spend at most MAX_SCAN_WORK impulse-evaluations per side (coarser beyond that). The
+        // impulses counted are the expanded shaper's (Π nₖ for a factored one), as before
+        // shapers were kept factored, though a convolution is evaluated from its Σ nₖ factor
+        // impulses: counting those instead (a finer step, the same work bound) made I(Vtol) at
+        // issue 24's six modes take 70 ms for ZVDD and 87 ms for ZV-D³ natively (2026-12-04,
+        // docs/page-performance.md), the bands of modes 2 … 6 reaching their 50 × f limits.
+        let h = direction * self.step(f_m, limit).0;
+        let mut rows = Rows::new(self.shaper, h);
+        let mut values = Vec::with_capacity(SCAN_CHUNK);
+        let mut inside = start;
         loop {
+            if direction > 0.0 && self.under_for_good(inside) {
+                return limit;
+            }
             let remaining = ((limit - inside) / h).floor().max(0.0) as usize;
             let n = remaining.min(SCAN_CHUNK);
             if n == 0 {
@@ -367,21 +504,14 @@ pub fn insensitivity(shaper: &Shaper, mode: &Mode, vtol: f64) -> Result<Insensit
                     limit
                 };
             }
-            rows.fill(inside + h, zeta, &mut values, n);
-            if let Some(k) = values.iter().position(|&v| v > threshold) {
+            rows.fill(inside + h, self.zeta, &mut values, n);
+            if let Some(k) = values.iter().position(|&v| v > self.threshold) {
                 let outside = inside + h * (k + 1) as f64;
                 return refine_crossing(&excess, inside + h * k as f64, outside);
             }
             inside += h * n as f64;
         }
-    };
-    let high_hz = edge(1.0, f_m * MAX_BAND_RATIO);
-    let low_hz = edge(-1.0, 0.0);
-    Ok(Insensitivity {
-        low_hz,
-        high_hz,
-        width: (high_hz - low_hz) / f_m,
-    })
+    }
 }
 
 /// Walks from `start` (where `excess ≤ 0`) towards `limit` in steps of `step` and returns the

@@ -2,7 +2,10 @@
 //! `MAX_IMPULSES`): every analysis computed from the factors against the same analysis of the
 //! expanded shaper where expansion is possible (≤ 4096 impulses), V against the closed form
 //! (the product of the factors' V), and issue 24's six modes with ZV-D³ (5⁶ = 15 625
-//! impulses), which `design` refused before.
+//! impulses), which `design` refused before. Then the faster paths against the ones they
+//! replace: I(Vtol)'s bounded scan against the full scan (bit for bit) and the joint scan
+//! against each mode's own (1e-12 × f), a command shaped by merging sorted runs against the
+//! sorted products (bit for bit), and the `factors` of a factored shaper's wire form.
 
 mod common;
 
@@ -14,8 +17,9 @@ use input_shaping::plant::{ModalPlant, Plant};
 use input_shaping::shaper::{MAX_CONVOLVED_IMPULSES, MAX_IMPULSES};
 use input_shaping::simulate::simulate_shaped;
 use input_shaping::vibration::{
-    damping_sensitivity, insensitivity, residual_vibration, sensitivity, vibration_rad,
-    DampingSensitivityOptions, SensitivityOptions,
+    damping_sensitivity, insensitivities, insensitivity, insensitivity_full_scan,
+    residual_vibration, sensitivity, vibration_rad, DampingSensitivityOptions, Insensitivity,
+    SensitivityOptions,
 };
 use input_shaping::{Impulse, Mode, Shaper, ShaperSpec};
 
@@ -228,4 +232,200 @@ fn a_convolution_past_the_factored_limit_is_refused() {
     // 5⁷ = 78 125 > MAX_CONVOLVED_IMPULSES.
     let e = design_for(&ShaperSpec::Zvdn { derivatives: 3 }, &modes).unwrap_err();
     assert_eq!(e.field(), Some("impulses"));
+}
+
+/// Shapers and mode sets the band scans are compared on: the page's four closed-form families
+/// over issue 24's six modes and over three modes, at damping 0, 0.02 and mixed, and random
+/// convolutions (negative amplitudes too) at random modes.
+fn band_cases() -> Vec<(String, Shaper, Vec<Mode>)> {
+    let mut cases = Vec::new();
+    let three = [(1.2, 0.012), (3.4, 0.013), (7.9, 0.02)];
+    let six = [1.2, 3.4, 7.9, 13.0, 21.0, 34.0];
+    let sets: Vec<(&str, Vec<Mode>)> = vec![
+        ("six ζ 0.02", six_modes()),
+        (
+            "six ζ 0",
+            six.iter().map(|&f| Mode::new(f, 0.0).unwrap()).collect(),
+        ),
+        (
+            "six ζ 0.1 / 0.02",
+            six.iter()
+                .enumerate()
+                .map(|(k, &f)| Mode::new(f, if k % 2 == 0 { 0.1 } else { 0.02 }).unwrap())
+                .collect(),
+        ),
+        (
+            "three",
+            three
+                .iter()
+                .map(|&(f, z)| Mode::new(f, z).unwrap())
+                .collect(),
+        ),
+    ];
+    for (name, modes) in sets {
+        for (family, spec) in [
+            ("ZV", ShaperSpec::Zv),
+            ("ZVD", ShaperSpec::Zvd),
+            ("ZVDD", ShaperSpec::Zvdd),
+            ("ZV-D3", ShaperSpec::Zvdn { derivatives: 3 }),
+            ("EI", ShaperSpec::Ei { vtol: 0.05 }),
+        ] {
+            if let Ok(shaper) = design_for(&spec, &modes) {
+                cases.push((format!("{family}, {name}"), shaper, modes.clone()));
+            }
+        }
+    }
+    let mut rng = Rng(0x2424_2424_2424_2424);
+    for k in 0..30 {
+        let (_, shaper) = random_pair(&mut rng);
+        let zeta = if k % 3 == 0 { 0.0 } else { 0.2 * rng.uniform() };
+        let modes = (0..3)
+            .map(|_| Mode::new(0.5 + 40.0 * rng.uniform(), zeta).unwrap())
+            .collect();
+        cases.push((format!("random {k}"), shaper, modes));
+    }
+    cases
+}
+
+#[test]
+fn the_bounded_band_scan_is_the_full_scan_bit_for_bit() {
+    // The decay bound only ends an upper scan where the full scan finds nothing either: the
+    // same edges to the last bit (the full scan is the path before the bound).
+    let mut stopped_early = 0;
+    for (name, shaper, modes) in band_cases() {
+        for m in &modes {
+            for vtol in [0.05, 0.2] {
+                let full = insensitivity_full_scan(&shaper, m, vtol).unwrap();
+                let bounded = insensitivity(&shaper, m, vtol).unwrap();
+                assert_eq!(
+                    bounded,
+                    full,
+                    "{name} at {} Hz, Vtol {vtol}",
+                    m.frequency_hz()
+                );
+                if full.high_hz == 50.0 * m.frequency_hz() && m.damping() > 0.0 {
+                    stopped_early += 1;
+                }
+            }
+        }
+    }
+    // The cases hold bands that reach the 50 × f limit with damping (where the bound can end
+    // the scan): the comparison is not vacuous.
+    assert!(stopped_early >= 10, "{stopped_early} bands to the limit");
+}
+
+/// Whether two bands agree: each edge to 1e-12 of the mode's frequency.
+fn same_band(a: &Insensitivity, b: &Insensitivity, f: f64) -> bool {
+    (a.low_hz - b.low_hz).abs() <= 1e-12 * f
+        && (a.high_hz - b.high_hz).abs() <= 1e-12 * f
+        && (a.width - b.width).abs() <= 1e-12
+}
+
+#[test]
+fn bands_scanned_jointly_are_each_modes_own() {
+    // insensitivities shares a band between the modes inside it (same damping); each must be
+    // the band insensitivity finds from that mode alone. Issue 24's six modes share one band for
+    // modes 2 … 6 (ZVD and longer at ζ 0.02), so the sharing is exercised.
+    let mut shared = 0;
+    for (name, shaper, modes) in band_cases() {
+        for vtol in [0.05, 0.2] {
+            let joint = insensitivities(&shaper, &modes, vtol).unwrap();
+            assert_eq!(joint.len(), modes.len());
+            for (m, j) in modes.iter().zip(&joint) {
+                let own = insensitivity(&shaper, m, vtol).unwrap();
+                let f = m.frequency_hz();
+                assert!(
+                    same_band(j, &own, f),
+                    "{name} at {f} Hz, Vtol {vtol}: {j:?} vs {own:?}"
+                );
+            }
+            shared += joint
+                .iter()
+                .zip(&modes)
+                .filter(|(b, m)| {
+                    modes.iter().any(|o| {
+                        o.frequency_hz() != m.frequency_hz()
+                            && b.low_hz < o.frequency_hz()
+                            && o.frequency_hz() < b.high_hz
+                    })
+                })
+                .count();
+        }
+    }
+    assert!(shared >= 20, "{shared} bands holding another mode");
+}
+
+#[test]
+fn the_wire_form_of_a_factored_shaper_carries_its_factors() {
+    // `factors` is written only for a factored shaper: the per-mode ZV-D³ shapers, whose
+    // convolution is `impulses`; read back, it is ignored.
+    let modes = six_modes();
+    let shaper = design_for(&ShaperSpec::Zvdn { derivatives: 3 }, &modes).unwrap();
+    let json = serde_json::to_value(shaper.to_data()).unwrap();
+    let factors: Vec<Vec<Impulse>> = serde_json::from_value(json["factors"].clone()).unwrap();
+    assert_eq!(factors.len(), 6);
+    for (f, m) in factors.iter().zip(&modes) {
+        assert_eq!(f, zv_dn(m, 3).unwrap().impulses());
+    }
+    let convolved = factors[1..]
+        .iter()
+        .map(|f| Shaper::new(f.clone()).unwrap())
+        .try_fold(Shaper::new(factors[0].clone()).unwrap(), |a, f| {
+            a.convolve_factored(&f)
+        })
+        .unwrap();
+    let impulses: Vec<Impulse> = serde_json::from_value(json["impulses"].clone()).unwrap();
+    assert_eq!(convolved.impulses(), &impulses[..]);
+    let back: input_shaping::shaper::ShaperData = serde_json::from_value(json).unwrap();
+    assert!(back.factors.is_none() && back.impulses == impulses);
+    // A shaper formed from its impulses has none.
+    let zvd = design_for(&ShaperSpec::Zvd, &modes[..3]).unwrap();
+    assert!(serde_json::to_value(zvd.to_data())
+        .unwrap()
+        .get("factors")
+        .is_none());
+}
+
+#[test]
+fn a_command_shaped_by_merged_runs_is_the_sorted_one_bit_for_bit() {
+    // Piecewise::shaped merges its sorted runs (one per knot of a short command); the path
+    // before it built every product and sorted them in Piecewise::new. Same knots, same order
+    // of merged ties, so equal to the last bit: trapezoids (also triangular, and starting at
+    // 0.3 s), an S-curve, shaped by multi-mode designs (coincident products in the ZVD ⊛ ZVD
+    // of one mode twice) and random convolutions with negative amplitudes.
+    use input_shaping::command::{s_curve, trapezoid};
+    use input_shaping::piecewise::{Knot, Piecewise};
+    let commands = [
+        trapezoid(1.0, 0.75, 8.0, 0.0).unwrap(),
+        trapezoid(0.01, 0.75, 8.0, 0.3).unwrap(),
+        trapezoid(-2.0, 1.5, 3.0, 0.0).unwrap(),
+        s_curve(1.0, 0.75, 8.0, 200.0, 0.0).unwrap(),
+    ];
+    let mode = Mode::new(3.0, 0.05).unwrap();
+    let zvd = zv_dn(&mode, 1).unwrap();
+    let mut shapers = vec![
+        zvd.convolve(&zvd).unwrap(),
+        design_for(&ShaperSpec::Zvdd, &six_modes()).unwrap(),
+        design_for(&ShaperSpec::Zvdn { derivatives: 3 }, &six_modes()[..4]).unwrap(),
+    ];
+    let mut rng = Rng(77);
+    for _ in 0..10 {
+        shapers.push(random_pair(&mut rng).1);
+    }
+    for c in &commands {
+        assert!(c.knots().len() <= 16);
+        for s in &shapers {
+            let mut products = Vec::new();
+            for k in c.knots() {
+                for imp in s.impulses() {
+                    products.push(Knot {
+                        time: k.time + imp.time,
+                        jumps: k.jumps.map(|j| j * imp.amplitude),
+                    });
+                }
+            }
+            let sorted = Piecewise::new(products).unwrap();
+            assert_eq!(c.shaped(s).unwrap(), sorted);
+        }
+    }
 }

@@ -49,6 +49,10 @@ export interface Shaper {
   impulses: Impulse[];
   /** Time of the last impulse, s. */
   duration: number;
+  /** Only for a convolution of more than 4096 impulses (up to 65 536), kept factored: its
+   * factors' impulses (one shaper's each), whose convolution `impulses` is. V of the shaper is
+   * the product of the factors' V. Ignored when the shaper is passed back. */
+  factors?: Impulse[][];
 }
 
 /** A shaper as the functions take it: `duration` is optional and ignored. */

@@ -154,11 +154,8 @@ fn designs(frame: &Frame) -> Result<(Vec<Shaper>, Vec<ShaperResult>), Error> {
             _ => design::design_for(spec, modes).map_err(|e| e.within(&format!("shapers[{k}]")))?,
         };
         let curve = vibration::sensitivity(&shaper, &frame.sensitivity).map_err(in_view)?;
-        let insensitivity = modes
-            .iter()
-            .map(|m| vibration::insensitivity(&shaper, m, view.vtol))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(in_view)?;
+        let insensitivity =
+            vibration::insensitivities(&shaper, modes, view.vtol).map_err(in_view)?;
         let klipper = match shaper.centroid_delay() {
             Some(_) => Some(crate::smoothing::klipper_figures(&shaper, view.scv).map_err(in_view)?),
             None => None,
