@@ -56,16 +56,24 @@ fi
 # *Speed*): node CPU time per axis about halved against "z" / `-Oz` (resonances_y_three.csv
 # 159 → 79 ms), opt-level 3 / `-O3` no faster, for 66.7 KB more gzip (255.0 → 321.7 KB).
 # The designer module stays at "z".
-# The page's main-thread module builds its dependencies (std, serde, plotters, nalgebra,
-# wasm-bindgen, ...) at "s" while the crate stays at 2 (DEPS_OPT below): 4.0 KB less gzip
-# (276 286 -> 272 287 B; "z" for them saved no more, 272 539 B), the page benchmark's update
-# no slower (docs/page-performance.md, *Shipped size*, 2026-12-05).
+# The page's main-thread module builds its dependencies that no frame spends time in (std,
+# serde, serde-wasm-bindgen, nalgebra, ...) at "s" while the crate and the drawing path
+# (plotters, its canvas backend, web-sys, js-sys, wasm-bindgen) stay at 2 (DEPS_OPT below):
+# 4.0 KB less gzip (276 286 -> 272 280 B), the page benchmark's updates no slower in
+# alternated runs; every dependency at "s" saved the same but its 4-shaper mode edit was
+# ~0.2 ms slower at p50, and "z" saved no more (docs/page-performance.md, *Shipped size*, 2026-12-05).
 # build_module FEATURES OUT_DIR OUT_NAME [OPT_LEVEL] [DEPS_OPT_LEVEL]
 build_module() {
   local features=$1 out=$2 name=$3 opt=${4:-z} deps=${5:-} dir=""
   local -x CARGO_PROFILE_RELEASE_OPT_LEVEL=$opt # this module's cargo builds only
   local config=()
-  if [ -n "$deps" ]; then config=(--config "profile.release.package.\"*\".opt-level=\"$deps\""); fi
+  if [ -n "$deps" ]; then
+    config=(--config "profile.release.package.\"*\".opt-level=\"$deps\"")
+    # The drawing path (every chart's every segment, each frame) stays at the crate's level.
+    for hot in plotters plotters-backend plotters-canvas web-sys js-sys wasm-bindgen; do
+      config+=(--config "profile.release.package.$hot.opt-level=$opt")
+    done
+  fi
   if [ "$use_nightly" = 1 ]; then
     # Its own target directory: other RUSTFLAGS and std would rebuild the stable builds' cache.
     if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build "${config[@]+"${config[@]}"}" --release --lib --target "$target" \
