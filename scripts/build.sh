@@ -56,13 +56,27 @@ fi
 # *Speed*): node CPU time per axis about halved against "z" / `-Oz` (resonances_y_three.csv
 # 159 → 79 ms), opt-level 3 / `-O3` no faster, for 66.7 KB more gzip (255.0 → 321.7 KB).
 # The designer module stays at "z".
-# build_module FEATURES OUT_DIR OUT_NAME [OPT_LEVEL]
+# The page's main-thread module builds its dependencies that no frame spends time in (std,
+# serde, serde-wasm-bindgen, nalgebra, ...) at "s" while the crate and the drawing path
+# (plotters, its canvas backend, web-sys, js-sys, wasm-bindgen) stay at 2 (DEPS_OPT below):
+# 4.0 KB less gzip (276 286 -> 272 280 B), the page benchmark's updates no slower in
+# alternated runs; every dependency at "s" saved the same but its 4-shaper mode edit was
+# ~0.2 ms slower at p50, and "z" saved no more (docs/page-performance.md, *Shipped size*, 2026-12-05).
+# build_module FEATURES OUT_DIR OUT_NAME [OPT_LEVEL] [DEPS_OPT_LEVEL]
 build_module() {
-  local features=$1 out=$2 name=$3 opt=${4:-z} dir=""
+  local features=$1 out=$2 name=$3 opt=${4:-z} deps=${5:-} dir=""
   local -x CARGO_PROFILE_RELEASE_OPT_LEVEL=$opt # this module's cargo builds only
+  local config=()
+  if [ -n "$deps" ]; then
+    config=(--config "profile.release.package.\"*\".opt-level=\"$deps\"")
+    # The drawing path (every chart's every segment, each frame) stays at the crate's level.
+    for hot in plotters plotters-backend plotters-canvas web-sys js-sys wasm-bindgen; do
+      config+=(--config "profile.release.package.$hot.opt-level=$opt")
+    done
+  fi
   if [ "$use_nightly" = 1 ]; then
     # Its own target directory: other RUSTFLAGS and std would rebuild the stable builds' cache.
-    if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build --release --lib --target "$target" \
+    if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build "${config[@]+"${config[@]}"}" --release --lib --target "$target" \
       --no-default-features --features "$features" --target-dir target/shipped -Z build-std=std,panic_abort; then
       dir=target/shipped
       how="$nightly, std built with it at opt-level $opt"
@@ -73,7 +87,7 @@ build_module() {
   fi
   if [ -z "$dir" ]; then
     dir=target
-    cargo build --release --lib --target "$target" --no-default-features --features "$features"
+    cargo build "${config[@]+"${config[@]}"}" --release --lib --target "$target" --no-default-features --features "$features"
     how="stable Rust, prebuilt std: larger"
   fi
   rm -rf "$out/$name.js" "$out/${name}_bg.wasm"
@@ -113,11 +127,11 @@ if [ -x node_modules/.bin/wasm-opt ]; then
 fi
 stamps=1 # 0 once a module fell back to stable Rust: nothing is stamped, the next build retries
 
-# module_key FEATURES OPT_LEVEL WASM_OPT_LEVEL
+# module_key FEATURES OPT_LEVEL WASM_OPT_LEVEL [DEPS_OPT_LEVEL]
 module_key() {
   bash scripts/stamp.sh --files crate Cargo.toml Cargo.lock .cargo/config.toml rust-toolchain \
     rust-toolchain.toml scripts/build.sh scripts/stamp.sh scripts/nightly.sh -- \
-    "features=$1" "opt-level=$2" "wasm-opt=$3" "nightly=$use_nightly" "$rustc_version" \
+    "features=$1" "opt-level=$2" "wasm-opt=$3" "deps-opt-level=${4:-}" "nightly=$use_nightly" "$rustc_version" \
     "$bindgen_version" "binaryen=$binaryen_version"
 }
 # outputs OUT_DIR NAME: what wasm-bindgen writes (and wasm-opt rewrites)
@@ -132,12 +146,12 @@ write_stamp() {
   { echo "$1"; outputs "$3" "$4" | xargs sha256sum; } > "$2.tmp" && mv "$2.tmp" "$2"
 }
 
-# module FEATURES OUT_DIR NAME OPT_LEVEL WASM_OPT_LEVEL: builds it unless up to date; its
+# module FEATURES OUT_DIR NAME OPT_LEVEL WASM_OPT_LEVEL [DEPS_OPT_LEVEL]: builds it unless up to date; its
 # wasm-opt runs in the background while the next one compiles.
 module() {
-  local features=$1 out=$2 name=$3 opt=$4 level=$5 key stamp
+  local features=$1 out=$2 name=$3 opt=$4 level=$5 deps=${6:-} key stamp
   stamp="$out/.$name.stamp"
-  key=$(module_key "$features" "$opt" "$level")
+  key=$(module_key "$features" "$opt" "$level" "$deps")
   if up_to_date "$key" "$stamp"; then
     echo "[build] $out/$name.js ($features): up to date, kept (FORCE=1 rebuilds)"
     return
@@ -149,7 +163,7 @@ module() {
   fi
   rm -f "$stamp"
   local before=$use_nightly
-  build_module "$features" "$out" "$name" "$opt"
+  build_module "$features" "$out" "$name" "$opt" "$deps"
   [ "$use_nightly" = "$before" ] || stamps=0
   local write=$stamps
   { shrink "$out/${name}_bg.wasm" "$level" && if [ "$write" = 1 ]; then write_stamp "$key" "$stamp" "$out" "$name"; fi; } &
@@ -161,7 +175,7 @@ pids=()
 stale=0
 module js-api pkg input_shaping z z
 if [ "$what" != --library ]; then
-  module js-playground pkg/page playground 2 2
+  module js-playground pkg/page playground 2 2 s
   module js-designer,solver pkg/page designer z z
   module js-recording pkg/page recording 2 2
   module js-corner pkg/page corner 2 2
