@@ -23,6 +23,9 @@ export const MAX_SHAPERS = 4;
 
 export const COMMAND_KINDS = ['step', 'trapezoid', 'sCurve', 'profile', 'sampled'];
 export const PLANT_KINDS = ['modal', 'pendulum'];
+/** The command fields that hold a name, and those that hold a list of numbers. */
+const NAME_FIELDS = ['shape', 'interpolation'];
+const LIST_FIELDS = ['values', 'modesHz'];
 
 /** A view with the simulation defaults and the given command. */
 const view = (command, extra = {}) => ({
@@ -218,10 +221,12 @@ function checkView(view, fail) {
     } else if (k === 'command') {
       if (!plain(v) || !COMMAND_KINDS.includes(v.kind)) fail(`view.command must be { kind: ${COMMAND_KINDS.join(' | ')}, … }`);
       for (const [ck, cv] of Object.entries(v)) {
-        // A profile's shape and a list's interpolation are names, its values / modesHz lists
-        // (the core judges them all and names the field).
-        const ok = ck === 'kind' || num(cv) || (typeof cv === 'string' && cv.length <= 40)
-          || (Array.isArray(cv) && cv.every(num));
+        // A profile's shape and a list's interpolation are names (letters only), its values and
+        // modesHz lists of numbers; every other field a number (the core judges the values and
+        // names the field).
+        const ok = ck === 'kind' || num(cv)
+          || (NAME_FIELDS.includes(ck) && typeof cv === 'string' && /^[A-Za-z]{1,40}$/.test(cv))
+          || (LIST_FIELDS.includes(ck) && Array.isArray(cv) && cv.every(num));
         if (!ok) fail(`view.command.${ck} must be a number, a name or a list of numbers`);
       }
     } else if (k === 'plant') {
