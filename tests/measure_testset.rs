@@ -474,6 +474,10 @@ fn the_sweeps_end_is_not_a_mode() {
             let spectrum = spectrum_of(&text, &name);
             let id = identify_spectrum(&spectrum, &IdentifyOptions::new(f64::NAN)).unwrap();
             let found = found_of(&id.modes);
+            // The sweep's end is seen, and a mode under it is not taken for one cut off there.
+            let end = id.sweep_end_hz.expect("the sweep's end");
+            assert!((128.0..133.3).contains(&end), "{name}: sweep end {end}");
+            assert_eq!(id.cut_off, None, "{name}: {:?}", id.notes);
             at_cliff.extend(
                 found
                     .iter()
@@ -514,5 +518,57 @@ fn the_sweeps_end_is_not_a_mode() {
         t.print_rows(false);
         assert!(found.iter().all(|m| m.0 < 129.0), "{file}: {found:?}");
         assert_eq!(t.within(), 2, "{file}: {found:?}");
+    }
+}
+
+/// A response cut off by the sweep's end (issue 20; a real Voron 0 file, bassco_v0_resonances_x,
+/// rises to Klipper's 133.33 Hz and came out as "no mode"): resonances files written from
+/// closed forms whose sweep ends at 133.3 Hz with the strongest mode above it. The mode is not
+/// invented (no mode at or past the cliff), the response is reported as cut off at the last
+/// fitted bin with a note for the user, and a mode under the end is still found within the
+/// targets.
+#[test]
+fn a_response_cut_off_by_the_sweeps_end_is_reported() {
+    let sets: [(&[(f64, f64, f64)], &[(f64, f64)]); 2] = [
+        (&[(60.0, 0.05, 0.3), (142.0, 0.04, 0.7)], &[(60.0, 0.05)]),
+        (&[(150.0, 0.05, 1.0)], &[]),
+    ];
+    let mut rng = Rng(134);
+    for (s, (modes, truth)) in sets.iter().enumerate() {
+        for draw in 0..2 {
+            let text = synthetic_resonances(modes, 20.0, 80, 133.3, &mut rng);
+            let name = format!("resonances_x_above{s}_{draw}.csv");
+            let spectrum = spectrum_of(&text, &name);
+            let id = identify_spectrum(&spectrum, &IdentifyOptions::new(f64::NAN)).unwrap();
+            let found = found_of(&id.modes);
+            let cut = id.cut_off.unwrap_or_else(|| {
+                panic!(
+                    "{name}: no cut-off (sweep end {:?}): {found:?}",
+                    id.sweep_end_hz
+                )
+            });
+            let end = id.sweep_end_hz.expect("the sweep's end");
+            assert_eq!(cut.frequency_hz, end, "{name}");
+            assert!((128.0..133.3).contains(&end), "{name}: sweep end {end}");
+            assert!(cut.prominence_db >= 6.0, "{name}: {cut:?}");
+            assert_eq!(id.notes.len(), 1, "{name}: {:?}", id.notes);
+            assert!(
+                id.notes[0].contains("higher maximum frequency"),
+                "{:?}",
+                id.notes
+            );
+            assert!(found.iter().all(|m| m.0 < 125.0), "{name}: {found:?}");
+            let mut t = Tally::default();
+            t.check(
+                &name,
+                "synthetic",
+                truth,
+                &found,
+                0.5 * spectrum.resolution_hz,
+            );
+            t.print_rows(false);
+            assert_eq!(t.spurious.len(), 0, "{name}: spurious modes");
+            assert_eq!(t.within(), truth.len(), "{name}: {found:?}");
+        }
     }
 }

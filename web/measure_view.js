@@ -315,9 +315,11 @@ function showModes(id) {
     el('td', { class: 'num', 'data-damping': String(m.damping) }, `${fmt(m.damping, 3)} ± ${fmt(m.dampingUncertainty, 2)}`),
     el('td', {}, METHOD[m.method] ?? m.method),
     el('td', { class: 'hint' }, (m.estimates ?? []).map((e) => `${METHOD[e.method] ?? e.method}: ${fmt(e.frequencyHz, 5)} Hz, ζ ${fmt(e.damping, 3)}`).join('; ')))));
-  if (id.modes.length === 0) {
+  if (id.modes.length === 0 && !(id.notes ?? []).length) {
     body.replaceChildren(el('tr', {}, el('td', { colspan: '5' }, 'No resonance peak stands out of the spectrum in this channel.')));
   }
+  // What the identification could not do (a response cut off by the sweep's end), under the modes.
+  body.append(...(id.notes ?? []).map((note) => el('tr', { 'data-note': '' }, el('td', { colspan: '5', class: 'hint' }, note))));
   $('measure-accept').disabled = id.modes.length === 0;
 }
 

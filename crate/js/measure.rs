@@ -379,8 +379,12 @@ mod serde_json_like {
 /// → `{ channel, modes: [{ frequencyHz, damping, frequencyUncertaintyHz, dampingUncertainty,
 /// method, peakFrequencyHz, peakPsd, prominenceDb, estimates: [...] }], spectrum: { frequencyHz,
 /// psd, … }, detectionSegmentLength, bandHz, freeDecay: { startS, endS, levelDb } | null,
-/// sweep: { bandHz, rateHzPerS } | null }` (`sweep`: the linear sweep read from a raw recording,
-/// whose modes were then fitted on its whole-record periodogram; `null` otherwise).
+/// sweep: { bandHz, rateHzPerS } | null, sweepEndHz, cutOff, notes }` (`sweep`: the linear
+/// sweep read from a raw recording, whose modes were then fitted on its whole-record
+/// periodogram; `null` otherwise. `sweepEndHz`: a spectrum file's sweep end, the last bin
+/// fitted before its cliff, or `null`. `cutOff: { frequencyHz, prominenceDb } | null`: a
+/// response still rising there, a mode at or above `frequencyHz` that the file does not hold
+/// (not in `modes`). `notes`: what could not be identified, in words for the user).
 #[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = identifyModes, unchecked_return_type = "Identification")]
 pub fn identify_modes(
@@ -494,6 +498,18 @@ fn identification_to_js(
         None => JsValue::NULL,
     };
     set(&out, "sweep", &sweep)?;
+    let or_null = |v: Option<JsValue>| v.unwrap_or(JsValue::NULL);
+    set(
+        &out,
+        "sweepEndHz",
+        &or_null(id.sweep_end_hz.map(JsValue::from_f64)),
+    )?;
+    let cut_off = match &id.cut_off {
+        Some(c) => Some(to_js(c)?),
+        None => None,
+    };
+    set(&out, "cutOff", &or_null(cut_off))?;
+    set(&out, "notes", &to_js(&id.notes)?)?;
     Ok(out.into())
 }
 

@@ -147,3 +147,40 @@ test('two runs of one axis are combined into one panel', async () => {
   assert.deepEqual(problems, []);
   await page.close();
 });
+
+/**
+ * A resonances file written here from a closed form (not by the identification code): a mode at
+ * 150 Hz, ζ 0.05, seen by an accelerometer under a sweep that ends at 133.3 Hz (Klipper's
+ * releases of 2021–2023), so the response still rises where the file's sweep ends; rows every
+ * 1.5625 Hz to 200 Hz as Klipper writes them.
+ */
+function cutOffFile() {
+  const rows = ['freq,psd_x,psd_y,psd_z,psd_xyz'];
+  for (let k = 0; k <= 128; k++) {
+    const f = k * 1.5625;
+    const taper = f >= 133.3 ? 0.01 : f > 130.3 ? 0.01 + 0.99 * 0.5 * (1 - Math.cos(Math.PI * (133.3 - f) / 3)) : 1;
+    // Base excitation: 1 − s²/(s² + 2ζωs + ω²) at s = iω, times f² (an accelerometer's PSD).
+    const [fi, z] = [150, 0.05];
+    const [dr, di] = [fi * fi - f * f, 2 * z * fi * f];
+    const d2 = dr * dr + di * di;
+    const [hr, hi] = [1 + f * f * dr / d2, -f * f * di / d2];
+    const x = taper * f * f * (hr * hr + hi * hi) + 20;
+    rows.push(`${f.toFixed(1)},${x.toExponential(3)},20,20,${(x + 40).toExponential(3)}`);
+  }
+  return Buffer.from(`${rows.join('\n')}\n`);
+}
+
+test('a response cut off by the sweep\'s end is said so, not shown as "no mode"', async () => {
+  const { page, problems } = await env.page({ width: 1280, height: 1000 });
+  await page.setInputFiles('#measure-file', { name: 'resonances_x_cutoff.csv', mimeType: 'text/csv', buffer: cutOffFile() });
+  await page.waitForSelector('#measure-modes tbody tr[data-note]', { timeout: 180000 });
+  const note = await page.textContent('#measure-modes tbody tr[data-note]');
+  assert.match(note, /still rises where the sweep ends \(13\d\.\d Hz/, note);
+  assert.match(note, /higher maximum frequency/, note);
+  const id = await page.evaluate(() => window.__measureView.result.identification);
+  assert.ok(id.cutOff && id.cutOff.frequencyHz === id.sweepEndHz, JSON.stringify(id.cutOff));
+  assert.ok(id.modes.every((m) => m.frequencyHz < 125), JSON.stringify(id.modes.map((m) => m.frequencyHz)));
+  assert.equal(await page.$('#measure-modes tbody tr td[colspan="5"]:not(.hint)'), null, 'no "no peak" line');
+  assert.deepEqual(problems, []);
+  await page.close();
+});

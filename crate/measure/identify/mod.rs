@@ -119,10 +119,11 @@ impl Slot {
 fn joint_fit(
     input: &ModelInput,
     halves: &[HalfPower],
+    beyond: Option<Seed>,
     max_modes: usize,
     slots: &mut Vec<Slot>,
 ) -> bool {
-    let seeds: Vec<Seed> = halves
+    let mut seeds: Vec<Seed> = halves
         .iter()
         .enumerate()
         .map(|(i, h)| Seed {
@@ -132,11 +133,20 @@ fn joint_fit(
             peak: Some(i),
         })
         .collect();
+    // A mode past the band's top (a response cut off by a sweep's end), fitted so that its
+    // flank is not read as modes inside the band, and never reported: the file does not hold
+    // its peak.
+    let past = seeds.len();
+    seeds.extend(beyond.map(|s| Seed {
+        peak: Some(past),
+        ..s
+    }));
     let Some(fitted) = fit_modes(input, &seeds, max_modes) else {
         return false;
     };
     for m in fitted {
         match m.peak {
+            Some(i) if i == past => {}
             Some(i) => slots[i].push_fit(m.estimate),
             None => slots.push(Slot {
                 peak_hz: m.estimate.frequency_hz,
@@ -355,6 +365,28 @@ pub struct Identification {
     /// The sweep, when the recording is one and its modes were fitted on its whole-record
     /// periodogram inside the swept band (`spectrum` is then the detection PSD).
     pub sweep: Option<Sweep>,
+    /// A spectrum file's sweep end, when its PSD shows one (the last bin fitted before the
+    /// cliff), Hz; `None` otherwise and for recordings.
+    pub sweep_end_hz: Option<f64>,
+    /// A response still rising where a spectrum file's sweep ends: a mode at or above
+    /// [`CutOff::frequency_hz`] whose peak the file does not hold. Not one of `modes` (its
+    /// frequency is only a lower bound, its damping unknown: nothing to design a shaper for),
+    /// but reported so that such a file does not come out as "no mode". `None` otherwise.
+    pub cut_off: Option<CutOff>,
+    /// What the identification could not do, in words for the user (a response cut off by
+    /// the sweep's end). Empty when none.
+    pub notes: Vec<String>,
+}
+
+/// A response cut off by the end of a spectrum file's sweep ([`Identification::cut_off`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct CutOff {
+    /// The last bin fitted before the sweep's cliff, Hz: the mode's peak lies at or above it.
+    pub frequency_hz: f64,
+    /// How far the response rises to it over the lowest point of its left flank (down to the
+    /// nearest higher bin or the band's start), dB.
+    pub prominence_db: f64,
 }
 
 /// Identifies the modes in `signal` (see the module docs).
@@ -377,6 +409,9 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         band_hz: band,
         free_decay: None,
         sweep: None,
+        sweep_end_hz: None,
+        cut_off: None,
+        notes: Vec::new(),
     };
     // A sweep (unless the segments are given): its whole-record periodogram inside its band;
     // otherwise (or when nothing is found there) the Welch path.
@@ -433,7 +468,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         enbw_bins: psd.enbw_bins,
         band,
     };
-    let joint = joint_fit(&input, &halves, options.max_modes, &mut slots);
+    let joint = joint_fit(&input, &halves, None, options.max_modes, &mut slots);
     if !joint && !halves.is_empty() {
         let bin = |f: f64| ((f / psd.resolution_hz).round() as usize).min(psd.psd.len() - 1);
         let (lo, hi) = (bin(band[0]).max(1), bin(band[1]));
@@ -492,6 +527,9 @@ pub fn identify_spectrum(
         band_hz: [f_lo, f_hi],
         free_decay: None,
         sweep: None,
+        sweep_end_hz: None,
+        cut_off: None,
+        notes: Vec::new(),
     };
     if hi < lo + 4 {
         return Ok(result);
@@ -513,7 +551,30 @@ pub fn identify_spectrum(
         enbw_bins: psd.enbw_bins,
         band: [f_lo, f_hi],
     };
-    joint_fit(&input, &halves, options.max_modes, &mut slots);
+    // A response still rising where the sweep ends: reported as cut off, and fitted as a mode
+    // past the band (its flank would otherwise be read as modes under the cliff).
+    result.sweep_end_hz = cut.map(|_| f_hi);
+    result.cut_off = cut
+        .and_then(|c| spectrum::rising_to_end(&grid, lo, c, options.min_prominence_db))
+        .map(|prominence_db| CutOff {
+            frequency_hz: f_hi,
+            prominence_db,
+        });
+    let beyond = result.cut_off.zip(cut).map(|(_, c)| Seed {
+        frequency_hz: 1.05 * f_hi,
+        damping: 0.05,
+        peak_psd: psd.psd[c] * if grid.normalized { f_hi + 0.1 } else { 1.0 },
+        peak: None,
+    });
+    joint_fit(&input, &halves, beyond, options.max_modes, &mut slots);
+    if let Some(c) = result.cut_off {
+        result.notes.push(format!(
+            "The response still rises where the sweep ends ({:.1} Hz, {:.0} dB over its left \
+             flank): a mode lies at or above {:.0} Hz, its frequency and damping cannot be read \
+             from this file. Re-run the test with a higher maximum frequency.",
+            c.frequency_hz, c.prominence_db, c.frequency_hz
+        ));
+    }
     result.modes = slots.into_iter().map(Slot::into_mode).collect();
     crate::sort::sort_by(&mut result.modes, |a, b| {
         a.frequency_hz.total_cmp(&b.frequency_hz)

@@ -184,11 +184,14 @@ pub(super) fn seeds(
 /// falls no faster than its low side rises (a narrow peak is the window's symmetric kernel),
 /// then flattens to its f⁻⁴ (PSD) asymptote. So a cliff at bin k is, on the un-normalised
 /// PSD, going up from the band's start: a fall of ≥ 8 dB from k to k + 3 (≥ 8 dB over
-/// 3 bins: 2.3–3.5 % of 133 Hz, hundreds of dB per decade), after no rise of more than 3 dB
-/// anywhere over k − 5..k (not a peak's flank: a peak that sharp rises as fast as it falls),
-/// at least twice the fall over k − 3..k (the slope steepens abruptly: not a mode's high side,
-/// whose fall per bin lessens away from its peak), and staying ≥ 6 dB under bin k for 6 bins
-/// past k + 3 (not an anti-resonance between two modes, whose notch comes back up). Returned:
+/// 3 bins: 2.3–3.5 % of 133 Hz, hundreds of dB per decade), after no rise of more than a
+/// third of that fall (or 3 dB) anywhere over k − 5..k (not a peak's flank: a peak that sharp
+/// rises as fast as it falls; a response rising into the cliff — a mode past the sweep's end —
+/// rises far more slowly than the cliff falls), at least twice the fall over k − 3..k (the
+/// slope steepens abruptly: not a mode's high side, whose fall per bin lessens away from its
+/// peak), and staying ≥ 6 dB under bin k from k + 3 to the file's last row (nothing comes back
+/// once the sweep has ended; an anti-resonance between two modes, however broad, comes back up
+/// to the next mode). Returned:
 /// the bin before the steepest one-bin drop of those 3, already inside the window's smear of
 /// the cliff; the caller fits up to the bin before it.
 /// Measured on 11 public Klipper files (docs/measured-data.md, *On real recordings*).
@@ -213,13 +216,60 @@ pub(super) fn sweep_end(grid: &Grid, lo: usize, hi: usize) -> Option<usize> {
             .map(|j| w[j] - w[..j].iter().cloned().fold(f64::INFINITY, f64::min))
             .fold(f64::NEG_INFINITY, f64::max);
         let before = db[k - 3] - db[k];
-        let after = db[k + 3..k + 9]
+        let after = db[k + 3..]
             .iter()
             .cloned()
             .fold(f64::NEG_INFINITY, f64::max);
-        fall >= 8.0 && rise <= 3.0 && fall >= 2.0 * before && after <= db[k] - 6.0
+        fall >= 8.0 && rise <= (fall / 3.0).max(3.0) && fall >= 2.0 * before && after <= db[k] - 6.0
     })?;
     let drop = |j: usize| db[j] - db[j + 1];
     let k = (k..k + 3).fold(k, |best, j| if drop(j) > drop(best) { j } else { best });
     Some(k)
+}
+
+/// The un-normalised PSD in dB, smoothed over 3 bins within `lo..=hi` (as the peaks are
+/// found: Klipper's bins are coarse), indexed from `lo`.
+fn smoothed_db(grid: &Grid, lo: usize, hi: usize) -> Vec<f64> {
+    let psd = &grid.psd;
+    let db: Vec<f64> = psd
+        .psd
+        .iter()
+        .zip(&psd.frequency_hz)
+        .map(|(v, f)| {
+            let v = if grid.normalized { v * (f + 0.1) } else { *v };
+            10.0 * v.max(1e-300).log10()
+        })
+        .collect();
+    (lo..=hi)
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(1).max(lo), (k + 1).min(hi));
+            db[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
+        })
+        .collect()
+}
+
+/// A response cut off by the sweep's end: the PSD (un-normalised, 3-bin smoothed) still
+/// rising at the last fitted bin `cut`. Its top — the higher of the last two bins (the
+/// cliff's smear takes a little off the last one) — stands `min_db` or more over the lowest
+/// point between it and the nearest higher bin on its left (or the band's start): the
+/// topographic prominence of a peak whose right side is not in the file. Returned: that
+/// prominence, dB. Such a response has its maximum at or past the sweep's end: where, and
+/// its damping, the file cannot say (issue 20: a file whose spectrum rises to the end must
+/// not come out as "no mode").
+pub(super) fn rising_to_end(grid: &Grid, lo: usize, cut: usize, min_db: f64) -> Option<f64> {
+    if cut < lo + 3 {
+        return None;
+    }
+    let sm = smoothed_db(grid, lo, cut);
+    let c = sm.len() - 1;
+    let top = sm[c].max(sm[c - 1]);
+    let mut low = top;
+    for &v in sm[..c - 1].iter().rev() {
+        if v > top {
+            break;
+        }
+        low = low.min(v);
+    }
+    let prominence = top - low;
+    (prominence >= min_db).then_some(prominence)
 }
