@@ -318,8 +318,14 @@ function showModes(id) {
   if (id.modes.length === 0 && !(id.notes ?? []).length) {
     body.replaceChildren(el('tr', {}, el('td', { colspan: '5' }, 'No resonance peak stands out of the spectrum in this channel.')));
   }
-  // What the identification could not do (a response cut off by the sweep's end), under the modes.
-  body.append(...(id.notes ?? []).map((note) => el('tr', { 'data-note': '' }, el('td', { colspan: '5', class: 'hint' }, note))));
+  // What the identification could not do (a response cut off by the sweep's end), under the table.
+  const table = $('measure-modes');
+  let notes = $('measure-notes');
+  if (!notes) {
+    notes = el('div', { id: 'measure-notes' });
+    (table.closest('.scroll') ?? table).after(notes);
+  }
+  notes.replaceChildren(...(id.notes ?? []).map((note) => el('p', { class: 'hint', 'data-note': '' }, note)));
   $('measure-accept').disabled = id.modes.length === 0;
 }
 

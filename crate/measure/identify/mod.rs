@@ -368,8 +368,8 @@ pub struct Identification {
     /// A spectrum file's sweep end, when its PSD shows one (the last bin fitted before the
     /// cliff), Hz; `None` otherwise and for recordings.
     pub sweep_end_hz: Option<f64>,
-    /// A response still rising where a spectrum file's sweep ends: a mode at or above
-    /// [`CutOff::frequency_hz`] whose peak the file does not hold. Not one of `modes` (its
+    /// A response still rising where a spectrum file's sweep ends: a mode peaking near or
+    /// past [`CutOff::frequency_hz`], whose peak the file does not hold. Not one of `modes` (its
     /// frequency is only a lower bound, its damping unknown: nothing to design a shaper for),
     /// but reported so that such a file does not come out as "no mode". `None` otherwise.
     pub cut_off: Option<CutOff>,
@@ -382,7 +382,8 @@ pub struct Identification {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "camelCase")]
 pub struct CutOff {
-    /// The last bin fitted before the sweep's cliff, Hz: the mode's peak lies at or above it.
+    /// The last bin fitted before the sweep's cliff, Hz: the mode peaks near it (within the
+    /// window's smear of the cliff, ±2 bins) or past it.
     pub frequency_hz: f64,
     /// How far the response rises to it over the lowest point of its left flank (down to the
     /// nearest higher bin or the band's start), dB.
@@ -570,9 +571,9 @@ pub fn identify_spectrum(
     if let Some(c) = result.cut_off {
         result.notes.push(format!(
             "The response still rises where the sweep ends ({:.1} Hz, {:.0} dB over its left \
-             flank): a mode lies at or above {:.0} Hz, its frequency and damping cannot be read \
-             from this file. Re-run the test with a higher maximum frequency.",
-            c.frequency_hz, c.prominence_db, c.frequency_hz
+             flank): a mode peaks near or past the end, its frequency and damping cannot be \
+             read from this file. Re-run the test with a higher maximum frequency.",
+            c.frequency_hz, c.prominence_db
         ));
     }
     result.modes = slots.into_iter().map(Slot::into_mode).collect();
