@@ -529,7 +529,9 @@ fn the_sweeps_end_is_not_a_mode() {
 /// targets.
 #[test]
 fn a_response_cut_off_by_the_sweeps_end_is_reported() {
-    let sets: [(&[(f64, f64, f64)], &[(f64, f64)]); 2] = [
+    // (the modes (f, ζ, gain), the true modes under the sweep's end)
+    type Case = (&'static [(f64, f64, f64)], &'static [(f64, f64)]);
+    let sets: [Case; 2] = [
         (&[(60.0, 0.05, 0.3), (142.0, 0.04, 0.7)], &[(60.0, 0.05)]),
         (&[(150.0, 0.05, 1.0)], &[]),
     ];
