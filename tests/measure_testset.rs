@@ -532,12 +532,12 @@ fn a_response_cut_off_by_the_sweeps_end_is_reported() {
     // (the modes (f, ζ, gain), the true modes under the sweep's end)
     type Case = (&'static [(f64, f64, f64)], &'static [(f64, f64)]);
     let sets: [Case; 2] = [
-        (&[(60.0, 0.05, 0.3), (142.0, 0.04, 0.7)], &[(60.0, 0.05)]),
+        (&[(60.0, 0.05, 0.5), (142.0, 0.04, 0.5)], &[(60.0, 0.05)]),
         (&[(150.0, 0.05, 1.0)], &[]),
     ];
     let mut rng = Rng(134);
     for (s, (modes, truth)) in sets.iter().enumerate() {
-        for draw in 0..2 {
+        for draw in 0..6 {
             let text = synthetic_resonances(modes, 20.0, 80, 133.3, &mut rng);
             let name = format!("resonances_x_above{s}_{draw}.csv");
             let spectrum = spectrum_of(&text, &name);

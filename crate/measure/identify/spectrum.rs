@@ -184,14 +184,23 @@ pub(super) fn seeds(
 /// falls no faster than its low side rises (a narrow peak is the window's symmetric kernel),
 /// then flattens to its f⁻⁴ (PSD) asymptote. So a cliff at bin k is, on the un-normalised
 /// PSD, going up from the band's start: a fall of ≥ 8 dB from k to k + 3 (≥ 8 dB over
-/// 3 bins: 2.3–3.5 % of 133 Hz, hundreds of dB per decade), after no rise of more than a
-/// third of that fall (or 3 dB) anywhere over k − 5..k (not a peak's flank: a peak that sharp
-/// rises as fast as it falls; a response rising into the cliff — a mode past the sweep's end —
-/// rises far more slowly than the cliff falls), at least twice the fall over k − 3..k (the
-/// slope steepens abruptly: not a mode's high side, whose fall per bin lessens away from its
-/// peak), and staying ≥ 6 dB under bin k from k + 3 to the file's last row (nothing comes back
-/// once the sweep has ended; an anti-resonance between two modes, however broad, comes back up
-/// to the next mode). Returned:
+/// 3 bins: 2.3–3.5 % of 133 Hz, hundreds of dB per decade) with ≥ 5 dB from one bin to the
+/// next among them (a step smeared by the window; a mode's high side falling into an
+/// anti-resonance falls ~3 dB per bin), at least twice the fall over k − 3..k (the slope
+/// steepens abruptly: not a mode's high side, whose fall per bin lessens away from its peak),
+/// and either
+/// - no rise of more than 3 dB anywhere over k − 5..k (not a peak's flank: a peak that sharp
+///   rises as fast as it falls) and the PSD staying ≥ 6 dB under bin k for the 6 bins past
+///   k + 3 (not an anti-resonance between two modes, whose notch comes back up); or
+/// - a response rising into the cliff (a mode past the sweep's end): bin k the top of
+///   k − 5..k (within 1.5 dB, three times the scatter of a bin averaged over 80 segments), its
+///   rise at most a third of the fall (it rises far more slowly than the cliff falls, while a
+///   sharp peak rises as fast as it falls), and the PSD staying ≥ 6 dB under bin k from
+///   k + 3 to the file's last row (a mode followed by a deep anti-resonance also falls from
+///   its top by far more than it rose, but its notch comes back up to the next mode, however
+///   far away: 60 Hz then 142 Hz, the notch near 70–80 Hz low for many bins).
+///
+/// Returned:
 /// the bin before the steepest one-bin drop of those 3, already inside the window's smear of
 /// the cliff; the caller fits up to the bin before it.
 /// Measured on 11 public Klipper files (docs/measured-data.md, *On real recordings*).
@@ -215,12 +224,17 @@ pub(super) fn sweep_end(grid: &Grid, lo: usize, hi: usize) -> Option<usize> {
         let rise = (1..w.len())
             .map(|j| w[j] - w[..j].iter().cloned().fold(f64::INFINITY, f64::min))
             .fold(f64::NEG_INFINITY, f64::max);
+        // Rising into k (k the top of the window): a response still rising at the cliff.
+        let top = w.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let rising_into = db[k] >= top - 1.5 && rise <= fall / 3.0;
         let before = db[k - 3] - db[k];
-        let after = db[k + 3..]
-            .iter()
-            .cloned()
-            .fold(f64::NEG_INFINITY, f64::max);
-        fall >= 8.0 && rise <= (fall / 3.0).max(3.0) && fall >= 2.0 * before && after <= db[k] - 6.0
+        let highest = |r: &[f64]| r.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let down = |r: &[f64]| highest(r) <= db[k] - 6.0;
+        let steepest = (k..k + 3).map(|j| db[j] - db[j + 1]).fold(0.0, f64::max);
+        fall >= 8.0
+            && steepest >= 5.0
+            && fall >= 2.0 * before
+            && ((rise <= 3.0 && down(&db[k + 3..k + 9])) || (rising_into && down(&db[k + 3..])))
     })?;
     let drop = |j: usize| db[j] - db[j + 1];
     let k = (k..k + 3).fold(k, |best, j| if drop(j) > drop(best) { j } else { best });
@@ -249,22 +263,26 @@ fn smoothed_db(grid: &Grid, lo: usize, hi: usize) -> Vec<f64> {
 }
 
 /// A response cut off by the sweep's end: the PSD (un-normalised, 3-bin smoothed) still
-/// rising at the last fitted bin `cut`. Its top — the higher of the last two bins (the
-/// cliff's smear takes a little off the last one) — stands `min_db` or more over the lowest
+/// rising into the last fitted bins. Its top — the highest of the last three (the window
+/// smears the cliff over ±2 bins, and the sweep's own taper takes a little off them) — stands
+/// `min_db` or more over the lowest
 /// point between it and the nearest higher bin on its left (or the band's start): the
 /// topographic prominence of a peak whose right side is not in the file. Returned: that
 /// prominence, dB. Such a response has its maximum at or past the sweep's end: where, and
 /// its damping, the file cannot say (issue 20: a file whose spectrum rises to the end must
 /// not come out as "no mode").
 pub(super) fn rising_to_end(grid: &Grid, lo: usize, cut: usize, min_db: f64) -> Option<f64> {
-    if cut < lo + 3 {
+    if cut < lo + 4 {
         return None;
     }
     let sm = smoothed_db(grid, lo, cut);
     let c = sm.len() - 1;
-    let top = sm[c].max(sm[c - 1]);
+    let top = sm[c - 2..]
+        .iter()
+        .cloned()
+        .fold(f64::NEG_INFINITY, f64::max);
     let mut low = top;
-    for &v in sm[..c - 1].iter().rev() {
+    for &v in sm[..c - 2].iter().rev() {
         if v > top {
             break;
         }
