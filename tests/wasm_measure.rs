@@ -135,8 +135,52 @@ fn welch_accepts_typed_and_plain_arrays_and_names_bad_fields() {
     .unwrap_err();
     assert_eq!(
         get(&e, "field").as_string().as_deref(),
-        Some("sampleRateHz")
+        Some("options.sampleRateHz")
     );
+}
+
+/// The library's own checks of an options object name the argument too (issue 21 item 1:
+/// `options.sampleRateHz`, not `sampleRateHz`), in every measured-data export; errors of the
+/// other arguments keep their own names.
+#[wasm_bindgen_test]
+fn option_errors_name_the_options_argument() {
+    let field = |e: JsValue| get(&e, "field").as_string().unwrap_or_default();
+    let x: Vec<f64> = (0..512).map(|i| (0.3 * i as f64).sin()).collect();
+    let signal = || -> JsValue { Float64Array::from(x.as_slice()).into() };
+    let e = api::fft_spectrum_js(signal(), js(r#"{"sampleRateHz":-1}"#)).unwrap_err();
+    assert_eq!(field(e), "options.sampleRateHz");
+    let e = api::welch_js(signal(), js(r#"{"sampleRateHz":100,"segmentLength":1}"#)).unwrap_err();
+    assert_eq!(field(e), "options.segmentLength");
+    let e = api::identify_modes(signal(), js(r#"{"sampleRateHz":100,"maxModes":0}"#)).unwrap_err();
+    assert_eq!(field(e), "options.maxModes");
+    let e = api::identify_modes(signal(), JsValue::UNDEFINED).unwrap_err();
+    assert_eq!(field(e), "options.sampleRateHz");
+    let bins: Vec<String> = (0..=128)
+        .map(|k| format!("{}", 1.5625 * k as f64))
+        .collect();
+    let psd: Vec<String> = (0..=128)
+        .map(|k| format!("{}", 1.0 + 100.0 / (1.0 + (k as f64 - 30.0).powi(2))))
+        .collect();
+    let text = format!(
+        r#"{{"frequencyHz":[{}],"psd":[{}]}}"#,
+        bins.join(","),
+        psd.join(",")
+    );
+    let spectrum = || js(&text);
+    let e = api::identify_modes(spectrum(), js(r#"{"maxModes":9}"#)).unwrap_err();
+    assert_eq!(field(e), "options.maxModes");
+    let e = api::recommend_shaper(
+        spectrum(),
+        JsValue::NULL,
+        js(r#"{"criterion":"klipper","testDampingRatios":[5]}"#),
+    );
+    assert_eq!(
+        e.err().map(field).as_deref(),
+        Some("options.testDampingRatios[0]")
+    );
+    // The samples' own error keeps its name.
+    let e = api::fft_spectrum_js(js("[1, \"a\", 3]"), js(r#"{"sampleRateHz":100}"#)).unwrap_err();
+    assert_eq!(field(e), "signal[1]");
 }
 
 /// `firmwareConfig` across the boundary: `{ text, warnings }`, and an error's `field` naming

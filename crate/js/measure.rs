@@ -58,6 +58,80 @@ pub(super) fn options<T: serde::de::DeserializeOwned + Default + std::fmt::Debug
     }
 }
 
+/// The keys of `welch`'s options.
+const WELCH_KEYS: &[&str] = &[
+    "sampleRateHz",
+    "segmentLength",
+    "overlap",
+    "window",
+    "kaiserBeta",
+    "symmetricWindow",
+    "detrend",
+    "scaling",
+    "preset",
+];
+/// The keys of `fftSpectrum`'s options.
+const FFT_KEYS: &[&str] = &["sampleRateHz", "window", "kaiserBeta", "detrend"];
+/// The keys of `identifyModes`' options checked after they are read (its `signal` option is an
+/// enumeration checked as it is read; a `signal` error is the samples').
+const IDENTIFY_KEYS: &[&str] = &[
+    "sampleRateHz",
+    "maxModes",
+    "minFrequencyHz",
+    "maxFrequencyHz",
+    "minProminenceDb",
+    "segmentLength",
+    "freeDecay",
+    "channel",
+];
+/// The keys of `recommendShaper`'s options.
+const RECOMMEND_KEYS: &[&str] = &[
+    "families",
+    "criterion",
+    "firmware",
+    "maxRemainingVibration",
+    "scv",
+    "uncertaintySigmas",
+    "minFrequencyHz",
+    "maxFrequencyHz",
+    "shapers",
+    "dampingRatio",
+    "maxSmoothing",
+    "maxVibrations",
+    "testDampingRatios",
+    "shaperFrequencies",
+    "shaperFrequencyRange",
+];
+/// The keys of `recommendShaper`'s spectrum.
+const SPECTRUM_KEYS: &[&str] = &[
+    "frequencyHz",
+    "psd",
+    "normalization",
+    "channel",
+    "psdX",
+    "psdY",
+    "psdZ",
+    "psdSum",
+    "runs",
+];
+
+/// An error of the library's own checks of an object argument, named from that argument
+/// (issue 21: `options.sampleRateHz`, not `sampleRateHz`): the core functions name an
+/// option by its key alone, so an error whose field starts with one of `keys` (the
+/// argument's) is put `within` the argument's name; any other error is left as it is.
+fn named_in(argument: &'static str, keys: &'static [&'static str]) -> impl Fn(Error) -> Error {
+    move |e| {
+        let head = e
+            .field()
+            .map(|f| f.split(['.', '[', ' ']).next().unwrap_or_default());
+        if head.is_some_and(|h| keys.contains(&h)) {
+            e.within(argument)
+        } else {
+            e
+        }
+    }
+}
+
 fn get(object: &JsValue, key: &str) -> JsValue {
     js_sys::Reflect::get(object, &key.into()).unwrap_or(JsValue::UNDEFINED)
 }
@@ -283,7 +357,9 @@ pub fn welch_js(
     } else {
         from_js(options, "options").map_err(js_error)?
     };
-    let psd = welch(&x, &opts).map_err(js_error)?;
+    let psd = welch(&x, &opts)
+        .map_err(named_in("options", WELCH_KEYS))
+        .map_err(js_error)?;
     psd_to_js(&psd)
 }
 
@@ -297,7 +373,9 @@ pub fn fft_spectrum_js(
 ) -> Result<JsValue, JsValue> {
     let x = f64_vec(&signal, "signal").map_err(js_error)?;
     let opts: FftOptions = from_js(options, "options").map_err(js_error)?;
-    let s = fft_spectrum(&x, &opts).map_err(js_error)?;
+    let s = fft_spectrum(&x, &opts)
+        .map_err(named_in("options", FFT_KEYS))
+        .map_err(js_error)?;
     let out = js_sys::Object::new();
     set(
         &out,
@@ -403,7 +481,9 @@ pub fn identify_modes(
     if is_spectrum {
         let spectrum = spectrum_from_js(&recording).map_err(js_error)?;
         let opts = identify_options(&options).map_err(js_error)?;
-        let id = identify_spectrum(&spectrum, &opts).map_err(js_error)?;
+        let id = identify_spectrum(&spectrum, &opts)
+            .map_err(named_in("options", IDENTIFY_KEYS))
+            .map_err(js_error)?;
         return identification_to_js(&id, get(&recording, "channel"), JsValue::NULL);
     }
     let choice: ChannelChoice = if options.is_object() {
@@ -413,7 +493,9 @@ pub fn identify_modes(
     };
     let mut opts = identify_options(&options).map_err(js_error)?;
     let (signal, name) = signal_to_identify(&recording, &choice, &mut opts).map_err(js_error)?;
-    let id = identify(&signal, &opts).map_err(js_error)?;
+    let id = identify(&signal, &opts)
+        .map_err(named_in("options", IDENTIFY_KEYS))
+        .map_err(js_error)?;
     let free_decay = to_js(&id.free_decay)?;
     identification_to_js(&id, name, free_decay)
 }
@@ -546,7 +628,10 @@ pub fn recommend_shaper(
         from_js(modes, "modes").map_err(js_error)?
     };
     let options: RecommendOptions = self::options(options, "options").map_err(js_error)?;
-    let r = recommend(&spectrum, &modes, &options).map_err(js_error)?;
+    let r = recommend(&spectrum, &modes, &options)
+        .map_err(named_in("options", RECOMMEND_KEYS))
+        .map_err(named_in("spectrum", SPECTRUM_KEYS))
+        .map_err(js_error)?;
     to_js(&r)
 }
 

@@ -211,16 +211,14 @@ function describe(v) {
  * Whether an error's `field` names the argument `name` of export `e` that was replaced by a
  * hostile value: `name`, or a field inside it (`options.points`, `modes[0]`), or one of the
  * export's documented aliases (a recording's content errors name `recording`, or
- * `recording (line 10)`); an options
- * object's own checks name its keys without `options.` (`sampleRateHz`, as documented). A
- * drawing export without a canvas (Node) always names `canvas` first.
+ * `recording (line 10)`). An options object's own checks name the argument too
+ * (`options.sampleRateHz`, issue 21). A drawing export without a canvas (Node) always names
+ * `canvas` first.
  */
 function namesArgument(field, e, name, canDraw) {
   if (e.canvas && !canDraw) return field === 'canvas';
   const under = (n) => field === n || field.startsWith(`${n}.`) || field.startsWith(`${n}[`) || field.startsWith(`${n} (`);
-  if (under(name) || (e.aliases?.[name] ?? []).some(under)) return true;
-  const valid = e.args()[e.names.indexOf(name)];
-  return name === 'options' && valid !== null && typeof valid === 'object' && Object.keys(valid).some(under);
+  return under(name) || (e.aliases?.[name] ?? []).some(under);
 }
 
 /** Sets a hostile value at a random depth inside `value` (an object or array); false if none. */
