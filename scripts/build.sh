@@ -98,6 +98,8 @@ build_module() {
   # checking off, so no `any` is left in a public signature (docs/js-api.md, *TypeScript*).
   sed -i -E '/^ *(readonly|export const) [A-Za-z0-9_$]+: \(/ s/\bany\b/unknown/g' \
     "$out/$name.d.ts" "$out/${name}_bg.wasm.d.ts"
+  # A freed object's methods answer the documented Error, not "null pointer passed to rust".
+  node scripts/guard-freed.mjs "$out/$name.js"
   echo "[build] $out/$name.js ($features): built by $how"
 }
 
@@ -130,7 +132,7 @@ stamps=1 # 0 once a module fell back to stable Rust: nothing is stamped, the nex
 # module_key FEATURES OPT_LEVEL WASM_OPT_LEVEL [DEPS_OPT_LEVEL]
 module_key() {
   bash scripts/stamp.sh --files crate Cargo.toml Cargo.lock .cargo/config.toml rust-toolchain \
-    rust-toolchain.toml scripts/build.sh scripts/stamp.sh scripts/nightly.sh -- \
+    rust-toolchain.toml scripts/build.sh scripts/stamp.sh scripts/nightly.sh scripts/guard-freed.mjs -- \
     "features=$1" "opt-level=$2" "wasm-opt=$3" "deps-opt-level=${4:-}" "nightly=$use_nightly" "$rustc_version" \
     "$bindgen_version" "binaryen=$binaryen_version"
 }
