@@ -205,16 +205,7 @@ pub(super) fn seeds(
 /// the cliff; the caller fits up to the bin before it.
 /// Measured on 11 public Klipper files (docs/measured-data.md, *On real recordings*).
 pub(super) fn sweep_end(grid: &Grid, lo: usize, hi: usize) -> Option<usize> {
-    let psd = &grid.psd;
-    let db: Vec<f64> = psd
-        .psd
-        .iter()
-        .zip(&psd.frequency_hz)
-        .map(|(v, f)| {
-            let v = if grid.normalized { v * (f + 0.1) } else { *v };
-            10.0 * v.max(1e-300).log10()
-        })
-        .collect();
+    let db = unnormalized_db(grid);
     let n = db.len();
     let start = lo.max(5);
     let end = hi.min(n.saturating_sub(10));
@@ -241,19 +232,24 @@ pub(super) fn sweep_end(grid: &Grid, lo: usize, hi: usize) -> Option<usize> {
     Some(k)
 }
 
-/// The un-normalised PSD in dB, smoothed over 3 bins within `lo..=hi` (as the peaks are
-/// found: Klipper's bins are coarse), indexed from `lo`.
-fn smoothed_db(grid: &Grid, lo: usize, hi: usize) -> Vec<f64> {
+/// The PSD in dB with Klipper's normalisation undone (the modal peaks are those of the
+/// un-normalised PSD), every bin of the grid.
+fn unnormalized_db(grid: &Grid) -> Vec<f64> {
     let psd = &grid.psd;
-    let db: Vec<f64> = psd
-        .psd
+    psd.psd
         .iter()
         .zip(&psd.frequency_hz)
         .map(|(v, f)| {
             let v = if grid.normalized { v * (f + 0.1) } else { *v };
             10.0 * v.max(1e-300).log10()
         })
-        .collect();
+        .collect()
+}
+
+/// The un-normalised PSD in dB, smoothed over 3 bins within `lo..=hi` (as the peaks are
+/// found: Klipper's bins are coarse), indexed from `lo`.
+fn smoothed_db(grid: &Grid, lo: usize, hi: usize) -> Vec<f64> {
+    let db = unnormalized_db(grid);
     (lo..=hi)
         .map(|k| {
             let (a, b) = (k.saturating_sub(1).max(lo), (k + 1).min(hi));
