@@ -149,3 +149,22 @@ test('the crane hoisting: the table is the library’s hoisted pendulum; a hoist
   assert.deepEqual(problems, []);
   await page.close();
 });
+
+test('hostile plant values in a link are refused as a state (web/state.js)', async () => {
+  const { fromHash } = await import('../../web/state.js');
+  const base = PRESETS.find((p) => p.id === 'crane-hoist').state;
+  const withPlant = (plant) => toHash({ ...base, view: { ...base.view, plant } });
+  assert.ok(fromHash(withPlant(base.view.plant)).state, 'the preset passes');
+  for (const plant of [
+    { kind: 'pendulum', hoist: { kind: 'trapezoid', distance: '<b>1</b>', maxVelocity: 1, maxAcceleration: 1 } },
+    { kind: 'pendulum', hoist: { kind: '<img>', distance: 1 } },
+    { kind: 'pendulum', hoist: 'x' },
+    { kind: 'modal', hoist: { kind: 'step', distance: 1 } },
+    { kind: 'twoMass', baseMass: '1', tipMass: 1, stiffness: 1 },
+    { kind: 'twoMass', baseMass: { a: 1 }, tipMass: 1, stiffness: 1 },
+  ]) {
+    const { error, state } = fromHash(withPlant(plant));
+    assert.equal(state, undefined, JSON.stringify(plant));
+    assert.match(error, /view\.plant/, error);
+  }
+});
