@@ -24,4 +24,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 common=(--bundle --minify --format=esm --target=es2020 --sourcemap --outdir=pkg/page --log-level=warning)
-node_modules/.bin/esbuild web/main.js web/measure_view.js web/corner_view.js web/measure_worker.js web/design_worker.js web/realise_view.js web/command_view.js "${common[@]}"
+node_modules/.bin/esbuild web/main.js web/measure_view.js web/corner_view.js web/measure_worker.js web/design_worker.js web/realise_view.js web/command_view.js web/plant_view.js "${common[@]}"

@@ -127,6 +127,20 @@ export function commandFields() {
   });
 }
 
+// The plant's fields (issue 23 item 2): web/plant_view.js, fetched when a plant other than the
+// modal one is first shown.
+let plantView = null;
+export function plantEditors() {
+  if (page.state.view.plant?.kind === 'modal') {
+    $('plant-params').replaceChildren();
+    return;
+  }
+  (plantView ??= import(new URL('./plant_view.js', import.meta.url).href)).then((m) => m.build(page, { field, changed: (c) => page.changed(c) }), (e) => {
+    plantView = null;
+    $('general-error').textContent = `Could not load the plant editor: ${e?.message ?? e}`;
+  });
+}
+
 function mapShaperOptions() {
   const sel = $('map-shaper');
   sel.replaceChildren(...page.state.shapers.map((s, k) => el('option', { value: String(k) },
@@ -145,6 +159,7 @@ export function rebuild() {
   $('mismatch').value = String(page.state.view.mismatch ?? '');
   if (Number.isFinite(page.state.view.mismatch)) $('mismatch-slider').value = String(page.state.view.mismatch);
   $('plant-kind').value = page.state.view.plant?.kind ?? 'modal';
+  plantEditors();
   $('command-kind').value = page.state.view.command?.kind ?? 'step';
   $('command-params').replaceChildren(...commandFields());
   mapShaperOptions();

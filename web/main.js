@@ -13,7 +13,7 @@ import { setupMeasure } from './measure.js';
 import { setupCorner, updateCorner } from './corner.js'; // corner (issue 23 item 3)
 import { $, el, readNumber, notice, download } from './dom.js';
 import { page } from './page.js';
-import { rebuild, commandFields, clearErrors, showError } from './editors.js';
+import { rebuild, commandFields, clearErrors, showError, plantEditors } from './editors.js';
 import { showResults, showExport } from './results.js';
 import { updateRealisation, withoutRealise } from './realise.js'; // realisation (issue 23, item 1)
 import { updateCommandView } from './command_load.js'; // profile and list commands (issue 23 item 2)
@@ -291,15 +291,22 @@ async function main() {
   $('mismatch').addEventListener('input', () => {
     page.state.view.mismatch = readNumber($('mismatch'));
     if (Number.isFinite(page.state.view.mismatch)) $('mismatch-slider').value = String(page.state.view.mismatch);
+    plantEditors();
     changed();
   });
   $('mismatch-slider').addEventListener('input', () => {
     $('mismatch').value = $('mismatch-slider').value;
     page.state.view.mismatch = Number($('mismatch-slider').value);
+    plantEditors();
     changed();
   });
   $('plant-kind').addEventListener('change', () => {
-    page.state.view.plant = $('plant-kind').value === 'pendulum' ? { kind: 'pendulum', gravity: 9.81, initialAngle: 0 } : { kind: 'modal' };
+    const kind = $('plant-kind').value;
+    // A two-mass spring of 1 kg and 1 kg with mode 1's frequency and damping (web/plant_view.js).
+    const w = 2 * Math.PI * (page.state.modes[0].frequencyHz || 1);
+    page.state.view.plant = kind === 'pendulum' ? { kind, gravity: 9.81, initialAngle: 0 }
+      : kind === 'twoMass' ? { kind, baseMass: 1, tipMass: 1, stiffness: +(w * w / 2).toPrecision(6), dampingCoefficient: +((page.state.modes[0].damping || 0) * w).toPrecision(6) } : { kind };
+    plantEditors();
     changed(true);
   });
   $('command-kind').addEventListener('change', () => {

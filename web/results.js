@@ -113,7 +113,7 @@ function showSimulation(result, color) {
     ['Acceleration peaks + valleys', (m) => String(m.accelerationPeakValleyCount)],
   ];
   syncRows($('simulation-summary').tBodies[0], rows.map(([name, f]) => [name, ...columns.map((c) => (c.m ? f(c.m) : '—'))]));
-  const plant = sim.plant === 'pendulum' ? 'nonlinear pendulum' : 'modal plant';
+  const plant = { pendulum: 'nonlinear pendulum', twoMass: 'two-mass spring' }[sim.plant] ?? 'modal plant';
   $('simulation-note').textContent = `(${plant}, actual modes ${sim.plantModesHz.map((f) => fmt(f, 4)).join(', ')} Hz = model × ${fmt(sim.mismatch, 4)}; ${sim.samples} samples over ${fmt(sim.duration, 4)} s)`;
 }
 

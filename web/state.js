@@ -12,7 +12,9 @@
 //                         distance, duration }         Veciana & Cardona's profiles
 //                     | { kind: 'sampled', samplePeriod, values: [], interpolation }
 //                                                      a list (web/command_view.js),
-//              plant: { kind: 'modal' } | { kind: 'pendulum', gravity?, initialAngle? },
+//              plant: { kind: 'modal' }
+//                   | { kind: 'twoMass', baseMass, tipMass, stiffness, dampingCoefficient? }
+//                   | { kind: 'pendulum', gravity?, initialAngle?, hoist?: a command (m) },
 //              mapShaper }                       which shaper the frequency × damping map shows
 //   corner?: { open, path: 'square' | 'ringingTower', sideMm, velocity, accel, scv, magnify,
 //              x: [{ frequencyHz, damping }], y: […] }   the printed-corner panel (web/corner_view.js)
@@ -22,7 +24,7 @@ export const MAX_MODES = 6;
 export const MAX_SHAPERS = 4;
 
 export const COMMAND_KINDS = ['step', 'trapezoid', 'sCurve', 'profile', 'sampled'];
-export const PLANT_KINDS = ['modal', 'pendulum'];
+export const PLANT_KINDS = ['modal', 'twoMass', 'pendulum'];
 /** The command fields that hold a name, and those that hold a list of numbers. */
 const NAME_FIELDS = ['shape', 'interpolation'];
 const LIST_FIELDS = ['values', 'modesHz'];
@@ -113,6 +115,29 @@ export const PRESETS = [
     },
   },
   // ---- end of the command presets ----
+  // ---- plant presets (issue 23 item 2): web/plant_view.js ----
+  {
+    id: 'two-mass',
+    title: 'Peláez & Singhose 2002 §3: a two-mass spring (1 kg base, 0.5 kg tip) with its rigid-body mode, ZV and ZVD for 1 Hz',
+    state: {
+      // ω = √(K(M₁ + M₂)/(M₁M₂)) (eq. 18): K = 4π²/3 N/m is 1 Hz; the damper c = 0.08 N·s/m is
+      // ζ = c(1/M₁ + 1/M₂)/(2ω) ≈ 0.019. The masses move together (the rigid-body mode) while the tip rings.
+      modes: [{ frequencyHz: 1, damping: 0.02 }],
+      shapers: [{ family: 'zv' }, { family: 'zvd' }],
+      view: view(trapezoid(1, 0.5, 2), { plant: { kind: 'twoMass', baseMass: 1, tipMass: 0.5, stiffness: 13.16, dampingCoefficient: 0.08 } }),
+    },
+  },
+  {
+    id: 'crane-hoist',
+    title: 'Overhead crane hoisting: 6.2 m cable wound up by 3 m during a 4 m move (ZV and ZVD for the initial length)',
+    state: {
+      // The shapers are designed for the initial 0.2 Hz; the swing speeds up as the cable shortens.
+      modes: [{ frequencyHz: 0.2, damping: 0 }],
+      shapers: [{ family: 'zv' }, { family: 'zvd' }],
+      view: view(trapezoid(4, 1, 2), { plant: { kind: 'pendulum', gravity: 9.81, initialAngle: 0, hoist: trapezoid(-3, 0.5, 0.5) } }),
+    },
+  },
+  // ---- end of the plant presets ----
   // ---- printer preset (issue 23): realisation (item 1) ----
   {
     id: 'printer',
@@ -219,24 +244,30 @@ function checkView(view, fail) {
     if (['vtol', 'scv', 'mismatch', 'mapShaper', 'fromHz', 'toHz', 'points', 'samples', 'duration', 'dampingTo'].includes(k)) {
       if (!num(v)) fail(`view.${k} must be a number`);
     } else if (k === 'command') {
-      if (!plain(v) || !COMMAND_KINDS.includes(v.kind)) fail(`view.command must be { kind: ${COMMAND_KINDS.join(' | ')}, … }`);
-      for (const [ck, cv] of Object.entries(v)) {
-        // A profile's shape and a list's interpolation are names (letters only), its values and
-        // modesHz lists of numbers; every other field a number (the core judges the values and
-        // names the field).
-        const ok = ck === 'kind' || num(cv)
-          || (NAME_FIELDS.includes(ck) && typeof cv === 'string' && /^[A-Za-z]{1,40}$/.test(cv))
-          || (LIST_FIELDS.includes(ck) && Array.isArray(cv) && cv.every(num));
-        if (!ok) fail(`view.command.${ck} must be a number, a name or a list of numbers`);
-      }
+      checkCommand(v, 'view.command', fail);
     } else if (k === 'plant') {
       if (!plain(v) || !PLANT_KINDS.includes(v.kind)) fail(`view.plant must be { kind: ${PLANT_KINDS.join(' | ')} }`);
       for (const [pk, pv] of Object.entries(v)) {
-        if (pk !== 'kind' && !num(pv)) fail(`view.plant.${pk} must be a number`);
+        if (pk === 'hoist' && v.kind === 'pendulum') {
+          if (pv !== null) checkCommand(pv, 'view.plant.hoist', fail);
+        } else if (pk !== 'kind' && !num(pv)) fail(`view.plant.${pk} must be a number`);
       }
     } else if (!(num(v) || typeof v === 'boolean' || (typeof v === 'string' && v.length <= 200))) {
       fail(`view.${k} has an unsupported value`);
     }
+  }
+}
+
+/** A command's shape (at `where`): a known kind; a profile's shape and a list's interpolation
+ * are names (letters only), its values and modesHz lists of numbers; every other field a number
+ * (the core judges the values and names the field). */
+function checkCommand(v, where, fail) {
+  if (!v || typeof v !== 'object' || Array.isArray(v) || !COMMAND_KINDS.includes(v.kind)) fail(`${where} must be { kind: ${COMMAND_KINDS.join(' | ')}, … }`);
+  for (const [ck, cv] of Object.entries(v)) {
+    const ok = ck === 'kind' || typeof cv === 'number' || cv === null
+      || (NAME_FIELDS.includes(ck) && typeof cv === 'string' && /^[A-Za-z]{1,40}$/.test(cv))
+      || (LIST_FIELDS.includes(ck) && Array.isArray(cv) && cv.every((x) => typeof x === 'number' || x === null));
+    if (!ok) fail(`${where}.${ck} must be a number, a name or a list of numbers`);
   }
 }
 

@@ -551,7 +551,10 @@ export interface PlaygroundView {
   pixelRatio?: number;
   mismatch?: number;
   command?: CommandSpec;
-  plant?: { kind: "modal" } | { kind: "pendulum"; gravity?: number; initialAngle?: number };
+  plant?:
+    | { kind: "modal" }
+    | { kind: "twoMass"; baseMass: number; tipMass: number; stiffness: number; dampingCoefficient?: number }
+    | { kind: "pendulum"; gravity?: number; initialAngle?: number; hoist?: CommandSpec | null };
   samples?: number;
   duration?: number | null;
   mapShaper?: number;
@@ -603,7 +606,7 @@ export interface PlaygroundResult {
   centroidDelay: number | null;
   simulation: {
     mismatch: number;
-    plant: "modal" | "pendulum";
+    plant: "modal" | "twoMass" | "pendulum";
     plantModesHz: number[];
     duration: number;
     samplePeriod: number;

@@ -201,7 +201,9 @@ fn simulation_charts(
     if let Some(b) = backend(&frame.canvases.response) {
         let plant_name = match frame.view.plant {
             ViewPlant::Modal => "",
-            ViewPlant::Pendulum { .. } => ", nonlinear pendulum",
+            ViewPlant::TwoMass(_) => ", two-mass spring",
+            ViewPlant::Pendulum { hoist: None, .. } => ", nonlinear pendulum",
+            ViewPlant::Pendulum { hoist: Some(_), .. } => ", nonlinear pendulum, hoisted",
         };
         let caption = format!(
             "Simulated response (actual f = model × {}{plant_name})",

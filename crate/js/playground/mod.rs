@@ -119,6 +119,7 @@ fn frame(state: JsValue, canvases: &JsValue) -> Result<PlaygroundResult, Error> 
             mismatch: frame.view.mismatch,
             plant: match frame.view.plant {
                 ViewPlant::Modal => "modal",
+                ViewPlant::TwoMass(_) => "twoMass",
                 ViewPlant::Pendulum { .. } => "pendulum",
             },
             plant_modes_hz: sim.plant_modes.iter().map(Mode::frequency_hz).collect(),

@@ -8,7 +8,7 @@ use crate::command::{Command, CommandSpec};
 use crate::design::ShaperSpec;
 use crate::error::Error;
 use crate::mode::{Mode, ModeSpec};
-use crate::plant::{ModalPlant, Pendulum, PendulumSpec, Plant};
+use crate::plant::{ModalPlant, Pendulum, PendulumSpec, Plant, TwoMass};
 use crate::shaper::{Shaper, ShaperData};
 use crate::spectrum::{SpectrumOptions, SpectrumSignal};
 use crate::vibration::SensitivityOptions;
@@ -113,11 +113,16 @@ impl Default for PlaygroundView {
 
 crate::tagged::tagged_enum! {
     tag = "kind", rename_all = "camelCase", mirror = view_plant_serde;
-    /// The playground's simulated plant: `modal` (the modes × mismatch, equal participation) or
-    /// `pendulum` (a nonlinear crane pendulum whose linearised mode is the first mode × mismatch).
-    #[derive(Debug, Clone, Copy)]
+    /// The playground's simulated plant: `modal` (the modes × mismatch, equal participation),
+    /// `twoMass` (Peláez & Singhose's two-mass spring with its rigid-body mode, its frequency ×
+    /// mismatch) or `pendulum` (a nonlinear crane pendulum whose linearised mode is the first
+    /// mode × mismatch, optionally hoisted).
+    #[derive(Debug, Clone)]
     pub(super) enum ViewPlant {
         Modal,
+        /// The two-mass spring as the library takes it (SI units); the mismatch r scales its
+        /// stiffness by r², so its frequency by r.
+        TwoMass(TwoMass),
         #[serde(rename_all = "camelCase")]
         Pendulum {
             /// Gravity, m/s² (default 9.81).
@@ -126,6 +131,10 @@ crate::tagged::tagged_enum! {
             /// Swing angle at t = 0, rad (default 0).
             #[serde(default)]
             initial_angle: f64,
+            /// The change of the cable length over time (a command, m), as the library's
+            /// pendulum takes it (`hoist`).
+            #[serde(default)]
+            hoist: Option<CommandSpec>,
         },
     }
 }
@@ -410,30 +419,42 @@ fn count_in(field: &str, value: usize, lo: usize, hi: usize) -> Result<usize, Er
 fn view_plant(modes: &[Mode], view: &PlaygroundView) -> Result<Plant, Error> {
     let r = within_range("view.mismatch", view.mismatch, 0.05, 20.0)?;
     let at_mismatch = |e: Error| Error::invalid("view.mismatch", e.to_string());
-    match view.plant {
+    let actual = modes
+        .iter()
+        .map(|m| Mode::new(m.frequency_hz() * r, m.damping()).map_err(at_mismatch))
+        .collect::<Result<Vec<_>, _>>()?;
+    match &view.plant {
         ViewPlant::Modal => {
-            let actual = modes
-                .iter()
-                .map(|m| Mode::new(m.frequency_hz() * r, m.damping()).map_err(at_mismatch))
-                .collect::<Result<Vec<_>, _>>()?;
             let share = 1.0 / actual.len() as f64;
             let participation = vec![share; actual.len()];
             Ok(Plant::Modal(
                 ModalPlant::new(actual, participation).map_err(|e| e.within("view.plant"))?,
             ))
         }
+        ViewPlant::TwoMass(given) => {
+            // Checked as given first, so an error names the field the page shows.
+            given.validate().map_err(|e| e.within("view.plant"))?;
+            let t = TwoMass {
+                stiffness: given.stiffness * r * r,
+                ..*given
+            };
+            t.validate()
+                .map_err(|e| Error::invalid("view.mismatch", e.to_string()))?;
+            Ok(Plant::TwoMass(t))
+        }
         ViewPlant::Pendulum {
             gravity,
             initial_angle,
+            hoist,
         } => {
-            let mode = &modes[0];
-            let omega = mode.omega_rad_s() * r;
+            let mode = &actual[0];
+            let omega = mode.omega_rad_s();
             let spec = PendulumSpec {
                 length: gravity / (omega * omega),
-                gravity,
+                gravity: *gravity,
                 damping: mode.damping(),
-                initial_angle,
-                hoist: None,
+                initial_angle: *initial_angle,
+                hoist: hoist.clone(),
             };
             Ok(Plant::Pendulum(
                 Pendulum::from_spec(&spec).map_err(|e| e.within("view.plant"))?,
