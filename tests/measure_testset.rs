@@ -458,25 +458,30 @@ fn no_spurious_modes_over_noise_draws() {
 /// within the targets, and none is reported at or past the cliff.
 #[test]
 fn the_sweeps_end_is_not_a_mode() {
-    let sets: [&[(f64, f64, f64)]; 3] = [
+    let sets: [&[(f64, f64, f64)]; 4] = [
         &[(50.0, 0.06, 0.5), (118.0, 0.04, 0.5)],
         &[(126.0, 0.03, 1.0)],
         &[(45.0, 0.05, 0.6), (123.0, 0.03, 0.4)],
+        &[(128.0, 0.015, 1.0)],
     ];
     let mut rng = Rng(133);
     let mut t = Tally::default();
     let mut at_cliff = Vec::new();
     for (s, modes) in sets.iter().enumerate() {
         let truth: Vec<(f64, f64)> = modes.iter().map(|m| (m.0, m.1)).collect();
-        for draw in 0..2 {
+        for draw in 0..std::env::var("DRAWS").map_or(2, |v| v.parse().unwrap()) {
             let text = synthetic_resonances(modes, 20.0, 80, 133.3, &mut rng);
             let name = format!("resonances_x_end{s}_{draw}.csv");
             let spectrum = spectrum_of(&text, &name);
             let id = identify_spectrum(&spectrum, &IdentifyOptions::new(f64::NAN)).unwrap();
             let found = found_of(&id.modes);
-            // The sweep's end is seen, and a mode under it is not taken for one cut off there.
-            let end = id.sweep_end_hz.expect("the sweep's end");
-            assert!((128.0..133.3).contains(&end), "{name}: sweep end {end}");
+            // The sweep's end is seen (but a sharp mode falling into the cliff, the last set,
+            // may hide it: its own fall is as steep), and a mode under it is not taken for one
+            // cut off there.
+            match id.sweep_end_hz {
+                Some(end) => assert!((128.0..133.3).contains(&end), "{name}: sweep end {end}"),
+                None => assert_eq!(s, 3, "{name}: the sweep's end not found"),
+            }
             assert_eq!(id.cut_off, None, "{name}: {:?}", id.notes);
             at_cliff.extend(
                 found
@@ -531,13 +536,14 @@ fn the_sweeps_end_is_not_a_mode() {
 fn a_response_cut_off_by_the_sweeps_end_is_reported() {
     // (the modes (f, ζ, gain), the true modes under the sweep's end)
     type Case = (&'static [(f64, f64, f64)], &'static [(f64, f64)]);
-    let sets: [Case; 2] = [
+    let sets: [Case; 3] = [
         (&[(60.0, 0.05, 0.5), (142.0, 0.04, 0.5)], &[(60.0, 0.05)]),
         (&[(150.0, 0.05, 1.0)], &[]),
+        (&[(72.0, 0.1, 0.5), (138.0, 0.03, 0.5)], &[(72.0, 0.1)]),
     ];
     let mut rng = Rng(134);
     for (s, (modes, truth)) in sets.iter().enumerate() {
-        for draw in 0..6 {
+        for draw in 0..std::env::var("DRAWS").map_or(6, |v| v.parse().unwrap()) {
             let text = synthetic_resonances(modes, 20.0, 80, 133.3, &mut rng);
             let name = format!("resonances_x_above{s}_{draw}.csv");
             let spectrum = spectrum_of(&text, &name);

@@ -115,14 +115,19 @@ impl Slot {
 }
 
 /// The joint fit of [`model`] seeded by the half-power estimates: each fitted mode joins its
-/// seed's slot; modes found in the residuals get slots of their own. False when it failed.
+/// seed's slot; modes found in the residuals get slots of their own. `beyond`, a mode seeded
+/// past the band's top, is not reported unless the fit brings it back under the sweep's end
+/// onto the top that the end shows (its frequency, the pair's second).
+/// None when the fit failed; else what became of `beyond`.
 fn joint_fit(
     input: &ModelInput,
     halves: &[HalfPower],
-    beyond: Option<Seed>,
+    beyond: Option<(Seed, f64)>,
     max_modes: usize,
     slots: &mut Vec<Slot>,
-) -> bool {
+) -> Option<PastFit> {
+    let near_hz = beyond.map_or(f64::NAN, |b| b.1);
+    let beyond = beyond.map(|b| b.0);
     let mut seeds: Vec<Seed> = halves
         .iter()
         .enumerate()
@@ -141,11 +146,37 @@ fn joint_fit(
         peak: Some(past),
         ..s
     }));
-    let Some(fitted) = fit_modes(input, &seeds, max_modes) else {
-        return false;
+    let fitted = fit_modes(input, &seeds, max_modes)?;
+    let end = input.sweep_end_hz.unwrap_or(f64::INFINITY);
+    // Stands 3 dB or more over the model without it at the band's top: the end needs it.
+    let mut past_fit = if fitted.top_db.get(past).is_some_and(|&db| db >= 3.0) {
+        PastFit::Needed
+    } else {
+        PastFit::NotNeeded
     };
-    for m in fitted {
+    for m in fitted.modes {
+        let (f, z) = (m.estimate.frequency_hz, m.estimate.damping);
         match m.peak {
+            // Fitted back into the band, its peak and high half-power point under the end, on
+            // the top the end shows (within 2 bins or its half-power width: not a mode
+            // elsewhere the seed wandered to), standing ≥ 3 dB over the model without it (as
+            // a mode found in the residuals must): a mode the file holds after all (a peak a
+            // few bins under the end whose fall into the cliff's smear is under the 3 dB the
+            // peak search asks for).
+            Some(i)
+                if i == past
+                    && f * (1.0 + z) <= end
+                    && (f - near_hz).abs() <= (2.0 * input.resolution_hz).max(2.0 * z * f)
+                    && m.standing_db >= 3.0 =>
+            {
+                past_fit = PastFit::Held;
+                slots.push(Slot {
+                    peak_hz: f,
+                    peak_psd: m.peak_psd,
+                    prominence_db: m.standing_db,
+                    estimates: vec![m.estimate],
+                })
+            }
             Some(i) if i == past => {}
             Some(i) => slots[i].push_fit(m.estimate),
             None => slots.push(Slot {
@@ -156,7 +187,18 @@ fn joint_fit(
             }),
         }
     }
-    true
+    Some(past_fit)
+}
+
+/// What became of the mode seeded past the band's top ([`joint_fit`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum PastFit {
+    /// Fitted back under the sweep's end: a mode of the band.
+    Held,
+    /// Past the band, standing ≥ 3 dB at its top: a response cut off by the end.
+    Needed,
+    /// Not needed (or none seeded): the band's own modes explain its top.
+    NotNeeded,
 }
 
 /// The peaks of a sweep's start (identify/raw.rs, `start_peaks`), each fitted alone on its
@@ -180,6 +222,7 @@ fn local_fits(psd: &Psd, locals: &[raw::Local], kind: SignalKind, slots: &mut Ve
             kind,
             enbw_bins: psd.enbw_bins,
             band: l.band,
+            sweep_end_hz: None,
         };
         let seed = Seed {
             frequency_hz: l.half.estimate.frequency_hz,
@@ -190,7 +233,7 @@ fn local_fits(psd: &Psd, locals: &[raw::Local], kind: SignalKind, slots: &mut Ve
         let Some(fitted) = fit_modes(&input, &[seed], 1) else {
             continue;
         };
-        let Some(m) = fitted.into_iter().find(|m| m.peak == Some(0)) else {
+        let Some(m) = fitted.modes.into_iter().find(|m| m.peak == Some(0)) else {
             continue;
         };
         let width = 2.0 * m.estimate.damping * m.estimate.frequency_hz;
@@ -468,9 +511,10 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         kind: options.signal,
         enbw_bins: psd.enbw_bins,
         band,
+        sweep_end_hz: None,
     };
     let joint = joint_fit(&input, &halves, None, options.max_modes, &mut slots);
-    if !joint && !halves.is_empty() {
+    if joint.is_none() && !halves.is_empty() {
         let bin = |f: f64| ((f / psd.resolution_hz).round() as usize).min(psd.psd.len() - 1);
         let (lo, hi) = (bin(band[0]).max(1), bin(band[1]));
         if let Some(fits) = spectrum_fit(&psd, &halves, lo, hi, options.signal) {
@@ -535,12 +579,15 @@ pub fn identify_spectrum(
     if hi < lo + 4 {
         return Ok(result);
     }
-    // The sweep's end (if the file shows one): no peak searched, no bin fitted past it.
-    let (cut, f_hi) = match spectrum::sweep_end(&grid, lo, hi) {
-        Some(e) if e >= lo + 5 => (Some(e - 1), psd.frequency_hz[e - 1]),
-        _ => (None, f_hi),
+    // The sweep's end (if the file shows one): `e` the bin before its steepest drop, the end
+    // itself where the smeared step is at half its level (`spectrum::end_hz`). No peak
+    // searched and no bin fitted from `e` on; the model's excitation stops at the end.
+    let end = spectrum::sweep_end(&grid, lo, hi).filter(|&e| e >= lo + 5);
+    let (cut, f_hi) = match end {
+        Some(e) => (Some(e - 1), psd.frequency_hz[e - 1]),
+        None => (None, f_hi),
     };
-    let (halves, mut slots) = spectrum::seeds(&grid, lo, hi, cut, options);
+    let (halves, mut slots, shoulder) = spectrum::seeds(&grid, lo, hi, cut, options);
     let input = ModelInput {
         frequency_hz: &psd.frequency_hz,
         psd: &psd.psd,
@@ -551,23 +598,50 @@ pub fn identify_spectrum(
         kind: options.signal,
         enbw_bins: psd.enbw_bins,
         band: [f_lo, f_hi],
+        sweep_end_hz: end.map(|e| spectrum::end_hz(&grid, e)),
     };
-    // A response still rising where the sweep ends: reported as cut off, and fitted as a mode
-    // past the band (its flank would otherwise be read as modes under the cliff).
+    // A response still rising into the sweep's end: fitted with a mode seeded past the band
+    // (its flank would otherwise be read as modes under the cliff), and reported as cut off
+    // unless the fit brings that mode back under the end (a peak a few bins under it).
     result.sweep_end_hz = cut.map(|_| f_hi);
-    result.cut_off = cut
-        .and_then(|c| spectrum::rising_to_end(&grid, lo, c, options.min_prominence_db))
-        .map(|prominence_db| CutOff {
+    let candidate = cut.and_then(|c| {
+        spectrum::rising_to_end(&grid, lo, c, options.min_prominence_db).map(|(p, top)| (c, p, top))
+    });
+    // (Without a candidate, a peak under the end whose fall into the cliff is under 3 dB gets
+    // the same trial from its own bin: a mode when the fit holds it under the end.)
+    let unnormalized = |k: usize| {
+        let f = psd.frequency_hz[k];
+        psd.psd[k] * if grid.normalized { f + 0.1 } else { 1.0 }
+    };
+    let beyond = match (candidate, shoulder) {
+        (Some((c, _, top)), _) => Some((1.05 * f_hi, unnormalized(c), top)),
+        (None, Some(k)) => Some((psd.frequency_hz[k], unnormalized(k), k)),
+        _ => None,
+    }
+    .map(|(frequency_hz, peak_psd, top)| {
+        let seed = Seed {
+            frequency_hz,
+            damping: 0.05,
+            peak_psd,
+            peak: None,
+        };
+        (seed, psd.frequency_hz[top])
+    });
+    let past = joint_fit(&input, &halves, beyond, options.max_modes, &mut slots);
+    // A cut-off unless the fit held the mode under the end, or did not need it and the
+    // candidate's top is a peak already seeded (a mode a few bins under the end explains it).
+    result.cut_off = candidate
+        .filter(|&(_, _, top)| match past {
+            Some(PastFit::Held) => false,
+            Some(PastFit::Needed) => true,
+            _ => !halves
+                .iter()
+                .any(|h| (h.peak_hz - psd.frequency_hz[top]).abs() <= 2.0 * df),
+        })
+        .map(|(_, prominence_db, _)| CutOff {
             frequency_hz: f_hi,
             prominence_db,
         });
-    let beyond = result.cut_off.zip(cut).map(|(_, c)| Seed {
-        frequency_hz: 1.05 * f_hi,
-        damping: 0.05,
-        peak_psd: psd.psd[c] * if grid.normalized { f_hi + 0.1 } else { 1.0 },
-        peak: None,
-    });
-    joint_fit(&input, &halves, beyond, options.max_modes, &mut slots);
     if let Some(c) = result.cut_off {
         result.notes.push(format!(
             "The response still rises where the sweep ends ({:.1} Hz, {:.0} dB over its left \

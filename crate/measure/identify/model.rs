@@ -21,6 +21,9 @@
 //!   spectral kernel |W(ν)|²/Σ|W|² (Welch 1967 eq. 7). K_j samples it every Δf/q over ±5
 //!   bins, q chosen so the narrowest half-power width spans ≥ 6 fine steps (a ζ = 0.01 mode at
 //!   50 Hz is 1 Hz wide, against Klipper's 1.56 Hz bins).
+//! - **A sweep's end** (a spectrum file whose excitation stops at f_e, Klipper's 133.33 Hz of
+//!   2021–2023): E(f) = 0 past f_e, so the bins next to it see the kernel's smear of the step
+//!   rather than a mode's fall.
 //! - **Klipper's normalisation** N(f) = 1/(f + 0.1) when the file has it applied (bins where
 //!   Klipper zeroed the PSD, below 5 Hz, are left out).
 //!
@@ -60,6 +63,10 @@ pub(crate) struct ModelInput<'a> {
     pub enbw_bins: f64,
     /// The band searched, Hz.
     pub band: [f64; 2],
+    /// Where a sweep's excitation ends (a spectrum file's cliff), Hz: the modal response is
+    /// zero past it (the floor stays), so bins within the kernel's reach of it see the
+    /// window's smear of the step.
+    pub sweep_end_hz: Option<f64>,
 }
 
 /// A seed: natural frequency, damping, PSD at the peak.
@@ -144,7 +151,14 @@ impl Problem<'_> {
         out.clear();
         let inp = self.input;
         let floor = x[3 * m + 2].exp();
-        let at = |f: f64| response(x, m, self.power, self.f_ref, f);
+        let end = inp.sweep_end_hz.unwrap_or(f64::INFINITY);
+        let at = |f: f64| {
+            if f < end {
+                response(x, m, self.power, self.f_ref, f)
+            } else {
+                0.0
+            }
+        };
         if kern.is_empty() {
             for &k in &self.bins {
                 let f = inp.frequency_hz[k];
@@ -167,7 +181,8 @@ impl Problem<'_> {
                 .collect();
             for &k in &self.bins {
                 let f = f0 + k as f64 * df;
-                let near = reach.iter().any(|&(fi, r)| (f - fi).abs() <= r);
+                let near = reach.iter().any(|&(fi, r)| (f - fi).abs() <= r)
+                    || (f - end).abs() <= (SPAN_BINS + 1) as f64 * df;
                 let value = if near {
                     kern.iter()
                         .enumerate()
@@ -458,53 +473,80 @@ fn residual_seed(problem: &Problem, x: &[f64], m: usize, q: usize) -> Option<See
     })
 }
 
+/// A fit's set-up: the problem on the fitted bins and the starts' levels.
+struct Setup<'a> {
+    problem: Problem<'a>,
+    /// The fitted range, Hz.
+    range: (f64, f64),
+    /// The floor's start: 0.3 × the 10th percentile of the normalised PSD.
+    floor: f64,
+    /// The direct term's start: the level at the low end of the range (where a mode's
+    /// acceleration response has fallen off).
+    direct: f64,
+    /// The bins counted as independent ones: n/ENBW.
+    n_eff: f64,
+}
+
+impl<'a> Setup<'a> {
+    /// The problem around `seeds` (their fitted range); None with too few bins.
+    fn new(input: &'a ModelInput<'a>, seeds: &[Seed]) -> Option<Self> {
+        let f = input.frequency_hz;
+        let (lo, hi) = fit_range(input, seeds);
+        let bins = fit_bins(input, seeds, lo, hi)?;
+        let problem = Problem {
+            input,
+            logs: bins.iter().map(|&k| input.psd[k].ln()).collect(),
+            f_ref: (lo * hi).sqrt(),
+            power: input.kind.power(),
+            bins,
+        };
+        let floor = {
+            let mut v: Vec<f64> = problem
+                .bins
+                .iter()
+                .map(|&k| input.psd[k] / problem.norm(f[k]))
+                .collect();
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 10].max(1e-300) * 0.3
+        };
+        let n_eff = problem.bins.len() as f64 / input.enbw_bins.max(1.0);
+        let direct = {
+            let k = problem.bins[0];
+            (input.psd[k] / problem.norm(f[k])).sqrt()
+        };
+        Some(Setup {
+            problem,
+            range: (lo, hi),
+            floor,
+            direct,
+            n_eff,
+        })
+    }
+
+    fn best_fit(&self, seeds: &[Seed]) -> Option<(FitResult, usize)> {
+        best_fit(&self.problem, seeds, self.floor, self.direct)
+    }
+}
+
 /// Fits the modes from `seeds` jointly, then adds modes found in the residuals while the
 /// information criterion says so (up to `max_modes`): a candidate is kept when the BIC (bins
 /// counted as n/ENBW) falls by more than 10 and it stands ≥ 3 dB over the model without it.
 /// None when no fit converged.
-pub(crate) fn fit_modes(
-    input: &ModelInput,
-    seeds: &[Seed],
-    max_modes: usize,
-) -> Option<Vec<FittedMode>> {
+pub(crate) fn fit_modes(input: &ModelInput, seeds: &[Seed], max_modes: usize) -> Option<Fitted> {
     if seeds.is_empty() {
         return None;
     }
-    let f = input.frequency_hz;
-    let (lo, hi) = fit_range(input, seeds);
-    let bins = fit_bins(input, seeds, lo, hi)?;
-    let problem = Problem {
-        input,
-        logs: bins.iter().map(|&k| input.psd[k].ln()).collect(),
-        f_ref: (lo * hi).sqrt(),
-        power: input.kind.power(),
-        bins,
-    };
-    let floor = {
-        let mut v: Vec<f64> = problem
-            .bins
-            .iter()
-            .map(|&k| input.psd[k] / problem.norm(f[k]))
-            .collect();
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 10].max(1e-300) * 0.3
-    };
-    let n_eff = problem.bins.len() as f64 / input.enbw_bins.max(1.0);
-    // The direct term's start: the level at the low end of the range (where a mode's
-    // acceleration response has fallen off).
-    let direct = {
-        let k = problem.bins[0];
-        (input.psd[k] / problem.norm(f[k])).sqrt()
-    };
+    let setup = Setup::new(input, seeds)?;
+    let (problem, n_eff) = (&setup.problem, setup.n_eff);
     let mut seeds = seeds.to_vec();
-    let mut best = best_fit(&problem, &seeds, floor, direct)?;
+    let mut best = setup.best_fit(&seeds)?;
     while seeds.len() < max_modes {
-        let Some(seed) = residual_seed(&problem, &best.0.x, seeds.len(), best.1) else {
+        let Some(seed) = residual_seed(problem, &best.0.x, seeds.len(), best.1) else {
             break;
         };
         let mut trial = seeds.clone();
         trial.push(seed);
-        let Some(candidate) = best_fit(&problem, &trial, floor, direct) else {
+        let Some(candidate) = setup.best_fit(&trial) else {
             break;
         };
         let k = trial.len() - 1;
@@ -516,7 +558,29 @@ pub(crate) fn fit_modes(
         seeds = trial;
         best = candidate;
     }
-    Some(modes_of(&problem, &best.0, &seeds, (lo, hi)))
+    let top = setup.range.1;
+    let top_db = (0..seeds.len())
+        .map(|i| {
+            let mut without = best.0.x.clone();
+            without[3 * i + 2] = 0.0;
+            let m = seeds.len();
+            10.0 * (problem.level(&best.0.x, m, top) / problem.level(&without, m, top).max(1e-300))
+                .log10()
+        })
+        .collect();
+    Some(Fitted {
+        modes: modes_of(problem, &best.0, &seeds, setup.range),
+        top_db,
+    })
+}
+
+/// What [`fit_modes`] found.
+pub(crate) struct Fitted {
+    /// The fitted modes inside the fitted range.
+    pub modes: Vec<FittedMode>,
+    /// How far each seed's mode (in the seeds' order, then those found in the residuals),
+    /// inside the range or not, stands over the model without it at the range's top, dB.
+    pub top_db: Vec<f64>,
 }
 
 /// The fitted modes inside the range, with their uncertainties s²(JᵀJ)⁻¹ inflated by √ENBW.

@@ -111,14 +111,15 @@ pub(super) fn band(grid: &Grid, options: &IdentifyOptions) -> Result<[f64; 2]> {
 /// searched in `lo..=cut` only, their prominence still read over `lo..=hi` (a mode just under
 /// the end has its high side's base past the cliff), and kept only when the PSD falls ≥ 3 dB
 /// between them and bin `cut`: their half-power point on the high side lies in the fitted bins. The cliff's
-/// shoulder, flat up to the cliff, is no such peak.
+/// shoulder, flat up to the cliff, is no such peak. The bin of the last peak dropped so (a
+/// mode a few bins under the end, or the cliff's shoulder: the fit tells) is returned too.
 pub(super) fn seeds(
     grid: &Grid,
     lo: usize,
     hi: usize,
     cut: Option<usize>,
     options: &IdentifyOptions,
-) -> (Vec<HalfPower>, Vec<Slot>) {
+) -> (Vec<HalfPower>, Vec<Slot>, Option<usize>) {
     let psd = &grid.psd;
     let df = psd.resolution_hz;
     let unnormalized = Psd {
@@ -131,7 +132,7 @@ pub(super) fn seeds(
         ..psd.clone()
     };
     let top = cut.unwrap_or(hi);
-    let peaks: Vec<_> = detect_within(
+    let (peaks, shoulders): (Vec<_>, Vec<_>) = detect_within(
         &unnormalized,
         [lo, top],
         [lo, hi],
@@ -140,7 +141,7 @@ pub(super) fn seeds(
         1,
     )
     .into_iter()
-    .filter(|pk| {
+    .partition(|pk| {
         let k = (pk.frequency_hz / df).round() as usize;
         cut.is_none_or(|c| {
             let low = unnormalized.psd[k.min(c)..=c]
@@ -149,8 +150,11 @@ pub(super) fn seeds(
                 .fold(f64::INFINITY, f64::min);
             unnormalized.psd[k] >= low * 10f64.powf(0.3)
         })
-    })
-    .collect();
+    });
+    let shoulder = shoulders
+        .iter()
+        .map(|pk| (pk.frequency_hz / df).round() as usize)
+        .max();
     let mut slots = Vec::new();
     let mut halves: Vec<HalfPower> = Vec::new();
     for pk in &peaks {
@@ -174,7 +178,7 @@ pub(super) fn seeds(
             });
         }
     }
-    (halves, slots)
+    (halves, slots, shoulder)
 }
 
 /// The end of the sweep in a spectrum file, the last bin before it (`None` when there is
@@ -194,8 +198,11 @@ pub(super) fn seeds(
 ///   k + 3 (not an anti-resonance between two modes, whose notch comes back up); or
 /// - a response rising into the cliff (a mode past the sweep's end): bin k the top of
 ///   k − 5..k (within 1.5 dB, three times the scatter of a bin averaged over 80 segments), its
-///   rise at most a third of the fall (it rises far more slowly than the cliff falls, while a
-///   sharp peak rises as fast as it falls), and the PSD staying ≥ 6 dB under bin k from
+///   rise at most a third of the fall, or its steepest rise per bin (on 3-bin means, where a
+///   bin's noise is a third) at most a third of the cliff's steepest drop per bin (it rises
+///   far more slowly than the cliff falls, while a sharp peak, the window's symmetric kernel,
+///   rises as fast as it falls: a sharp mode just past the end rises 8 dB over the 5 bins
+///   but ≤ 2 dB per bin into a 10 dB step), and the PSD staying ≥ 6 dB under bin k from
 ///   k + 3 to the file's last row (a mode followed by a deep anti-resonance also falls from
 ///   its top by far more than it rose, but its notch comes back up to the next mode, however
 ///   far away: 60 Hz then 142 Hz, the notch near 70–80 Hz low for many bins).
@@ -217,11 +224,18 @@ pub(super) fn sweep_end(grid: &Grid, lo: usize, hi: usize) -> Option<usize> {
             .fold(f64::NEG_INFINITY, f64::max);
         // Rising into k (k the top of the window): a response still rising at the cliff.
         let top = w.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-        let rising_into = db[k] >= top - 1.5 && rise <= fall / 3.0;
+        let steepest = (k..k + 3).map(|j| db[j] - db[j + 1]).fold(0.0, f64::max);
+        // The steepest rise per bin into k, on the 3-bin mean (its noise a third of a bin's
+        // power, ~0.3 dB over 80 segments) of the bins up to k.
+        let mean3 = |j: usize| (db[j - 1] + db[j] + db[j + 1]) / 3.0;
+        let steepest_rise = (k - 3..k)
+            .map(|j| mean3(j) - mean3(j - 1))
+            .fold(0.0, f64::max);
+        let rising_into =
+            db[k] >= top - 1.5 && (rise <= fall / 3.0 || 3.0 * steepest_rise <= steepest);
         let before = db[k - 3] - db[k];
         let highest = |r: &[f64]| r.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
         let down = |r: &[f64]| highest(r) <= db[k] - 6.0;
-        let steepest = (k..k + 3).map(|j| db[j] - db[j + 1]).fold(0.0, f64::max);
         fall >= 8.0
             && steepest >= 5.0
             && fall >= 2.0 * before
@@ -230,6 +244,24 @@ pub(super) fn sweep_end(grid: &Grid, lo: usize, hi: usize) -> Option<usize> {
     let drop = |j: usize| db[j] - db[j + 1];
     let k = (k..k + 3).fold(k, |best, j| if drop(j) > drop(best) { j } else { best });
     Some(k)
+}
+
+/// Where the excitation ends, Hz, given [`sweep_end`]'s bin `e`: where the un-normalised PSD
+/// crosses 3 dB under its level at `e − 1` (interpolated in dB between bins `e − 1 … e + 2`),
+/// the half-level point of the window's smear of a step (the real files' cliff: their bin
+/// 1.3 bins under Klipper's 133.33 Hz is ≤ 0.3 dB down, the one 0.3 bins under it ~3 dB,
+/// docs/measured-data.md), and of a gentler taper's middle. Half a bin past `e` when the
+/// drop is not found there.
+pub(super) fn end_hz(grid: &Grid, e: usize) -> f64 {
+    let db = unnormalized_db(grid);
+    let f = &grid.psd.frequency_hz;
+    let df = grid.psd.resolution_hz;
+    let level = db[e - 1] - 3.0;
+    (e - 1..(e + 2).min(db.len() - 1))
+        .find(|&j| db[j] >= level && db[j + 1] < level)
+        .map_or(f[e] + 0.5 * df, |j| {
+            f[j] + df * (db[j] - level) / (db[j] - db[j + 1])
+        })
 }
 
 /// The PSD in dB with Klipper's normalisation undone (the modal peaks are those of the
@@ -264,19 +296,28 @@ fn smoothed_db(grid: &Grid, lo: usize, hi: usize) -> Vec<f64> {
 /// `min_db` or more over the lowest
 /// point between it and the nearest higher bin on its left (or the band's start): the
 /// topographic prominence of a peak whose right side is not in the file. Returned: that
-/// prominence, dB. Such a response has its maximum at or past the sweep's end: where, and
-/// its damping, the file cannot say (issue 20: a file whose spectrum rises to the end must
-/// not come out as "no mode").
-pub(super) fn rising_to_end(grid: &Grid, lo: usize, cut: usize, min_db: f64) -> Option<f64> {
+/// prominence, dB, and the top's bin. Such a response may have its maximum at or past the
+/// sweep's end (where, and its damping, the file cannot say: issue 20, a file whose spectrum
+/// rises to the end must not come out as "no mode"), or be a mode a few bins under it: the
+/// caller's fit tells (identify/mod.rs, `identify_spectrum`).
+pub(super) fn rising_to_end(
+    grid: &Grid,
+    lo: usize,
+    cut: usize,
+    min_db: f64,
+) -> Option<(f64, usize)> {
     if cut < lo + 4 {
         return None;
     }
     let sm = smoothed_db(grid, lo, cut);
     let c = sm.len() - 1;
-    let top = sm[c - 2..]
-        .iter()
-        .cloned()
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (at, top) = (c - 2..=c).fold((c, f64::NEG_INFINITY), |best, j| {
+        if sm[j] > best.1 {
+            (j, sm[j])
+        } else {
+            best
+        }
+    });
     let mut low = top;
     for &v in sm[..c - 2].iter().rev() {
         if v > top {
@@ -285,5 +326,5 @@ pub(super) fn rising_to_end(grid: &Grid, lo: usize, cut: usize, min_db: f64) -> 
         low = low.min(v);
     }
     let prominence = top - low;
-    (prominence >= min_db).then_some(prominence)
+    (prominence >= min_db).then_some((prominence, lo + at))
 }
