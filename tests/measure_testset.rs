@@ -454,8 +454,10 @@ fn no_spurious_modes_over_noise_draws() {
 /// resonances files written from closed forms whose sweep ends at 133.3 Hz, as Klipper's
 /// releases of 2021–2023 did (rows to 200 Hz), with a mode 15 Hz under the end (the response
 /// high at the cliff: without the rule a lightly damped mode is fitted to the cliff's
-/// shoulder) and, the guard, genuine modes 7 and 10 Hz under it: every true mode is found
-/// within the targets, and none is reported at or past the cliff.
+/// shoulder) and, the guard, genuine modes 7 and 10 Hz under it, and a sharp one (ζ 0.015)
+/// 5 Hz under it whose fall into the cliff is under 3 dB: every true mode is found within the
+/// targets, none is reported at or past the cliff, and none is taken for a response cut off
+/// there. `DRAWS=n` sets the noise draws per set (2; docs/measured-data.md gives 30).
 #[test]
 fn the_sweeps_end_is_not_a_mode() {
     let sets: [&[(f64, f64, f64)]; 4] = [
@@ -531,7 +533,9 @@ fn the_sweeps_end_is_not_a_mode() {
 /// closed forms whose sweep ends at 133.3 Hz with the strongest mode above it. The mode is not
 /// invented (no mode at or past the cliff), the response is reported as cut off at the last
 /// fitted bin with a note for the user, and a mode under the end is still found within the
-/// targets.
+/// targets — also with a sharp mode (ζ 0.03) 4.7 Hz past the end, whose flank rises 8 dB over
+/// the last 5 bins (the time-domain case c6 of benches/reference/sweep_cutoff_cases.py).
+/// `DRAWS=n` sets the noise draws per set (6; docs/measured-data.md gives 30).
 #[test]
 fn a_response_cut_off_by_the_sweeps_end_is_reported() {
     // (the modes (f, ζ, gain), the true modes under the sweep's end)
