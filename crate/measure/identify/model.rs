@@ -320,7 +320,10 @@ fn fit_range(input: &ModelInput, seeds: &[Seed]) -> (f64, f64) {
 
 /// A narrow sweep's band edges in bins `k_lo..k_hi`: going out from the outermost seeds, a
 /// fall of more than 12 dB from one bin to the next that does not come back (a mode's flank,
-/// smoothed by the window, is gentler). Returns (low edge, high edge), Hz.
+/// smoothed by the window, is gentler), or, on a Welch average, of more than 15 dB over two
+/// bins onto a floor (a step falling between two bins: a sweep's start at 35.8 Hz read on
+/// Klipper's psd_xyz fell 12.0 and 4.0 dB, and a spurious mode was fitted to it). Returns
+/// (low edge, high edge), Hz.
 fn band_edges(
     input: &ModelInput,
     seeds: &[Seed],
@@ -343,13 +346,38 @@ fn band_edges(
         .map(|s| s.frequency_hz)
         .fold(f64::INFINITY, f64::min);
     let seed_hi = seeds.iter().map(|s| s.frequency_hz).fold(0.0, f64::max);
-    let edge_hi = (k_lo + 1..k_hi)
-        .find(|&k| f[k - 1] > seed_hi && drop(k - 1, k) < -12.0 && drop(k, k + 1) < 3.0)
-        .map(|k| f[k - 1] + 0.5 * df);
-    let edge_lo = (k_lo + 1..k_hi)
-        .rev()
-        .find(|&k| f[k + 1] < seed_lo && drop(k + 1, k) < -12.0 && drop(k, k - 1) < 3.0)
-        .map(|k| f[k + 1] - 0.5 * df);
+    // Or the step split over two bins (where it falls between them): more than 15 dB over two,
+    // and no bin of the next four coming back above the second's level by 1 dB (the floor) —
+    // on a Welch average only (a spectrum file's Kaiser window: Klipper's PSD averages tens to
+    // hundreds of segments): a raw record's single periodogram scatters by ~5 dB per bin.
+    let averaged = matches!(input.window, Some(w) if w.kind == WindowKind::Kaiser);
+    let flat = |k: usize, out: std::ops::Range<usize>| out.into_iter().all(|j| drop(k, j) < 1.0);
+    let edge_hi = (k_lo + 2..k_hi).find_map(|k| {
+        if f[k - 1] > seed_hi && drop(k - 1, k) < -12.0 && drop(k, k + 1) < 3.0 {
+            Some(f[k - 1] + 0.5 * df)
+        } else if averaged
+            && f[k - 2] > seed_hi
+            && drop(k - 2, k) < -15.0
+            && flat(k, k + 1..(k + 5).min(k_hi + 1))
+        {
+            Some(f[k - 1])
+        } else {
+            None
+        }
+    });
+    let edge_lo = (k_lo + 2..k_hi - 1).rev().find_map(|k| {
+        if f[k + 1] < seed_lo && drop(k + 1, k) < -12.0 && drop(k, k - 1) < 3.0 {
+            Some(f[k + 1] - 0.5 * df)
+        } else if averaged
+            && f[k + 2] < seed_lo
+            && drop(k + 2, k) < -15.0
+            && flat(k, k.saturating_sub(4).max(k_lo)..k)
+        {
+            Some(f[k + 1])
+        } else {
+            None
+        }
+    });
     (edge_lo, edge_hi)
 }
 
