@@ -278,8 +278,9 @@ fn every_case_of_the_independent_test_set() {
     for (label, within, rows, spurious) in &summary {
         println!("{label:<28} {within} of {rows} within the targets, {spurious} spurious");
     }
-    // Issue 20's target is every mode; today 46 of 49 meet it (42 of 45 before the case
-    // cliff133 was added, 86a9f82; see docs/measured-data.md: the
+    // Issue 20's target is every mode; today 48 of 51 meet it (46 of 49 before the case
+    // short36x123, whose start a spectrum file showed split over two bins, was added; 42 of
+    // 45 before the case cliff133, 86a9f82; see docs/measured-data.md: the
     // slow machine's 1, 3.4 and 11 Hz modes from its resonances file — 13 bins of 1.95 Hz,
     // the sweep ending at 16 Hz — miss; its 1 Hz mode from the raw file, below the part of the
     // sweep whose spectrum is smooth, is met since the sweep's start peaks are fitted alone:
@@ -289,8 +290,8 @@ fn every_case_of_the_independent_test_set() {
     // be added that is not there, and the true ones must come out as well.
     for (label, within, rows, spurious) in &summary {
         assert!(
-            *within >= 46,
-            "{label}: {} of {rows} modes outside the targets (46 met when this bound was set)",
+            *within >= 48,
+            "{label}: {} of {rows} modes outside the targets (48 met when this bound was set)",
             rows - within
         );
         assert_eq!(*spurious, 0, "{label}: {spurious} spurious modes");

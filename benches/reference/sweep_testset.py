@@ -375,6 +375,14 @@ def cases():
                   excitation=exc(5.0, 133.33), outputs=["resonances", "calibration_data"],
                   note="sweep 5-133.33 Hz at 1 Hz/s (Klipper 2021-2023's default band), "
                        "a mode 10 Hz under its end; " + full.replace("5-200", "5-133.33")))
+    # A short sweep's resonances file whose start falls between two bins (Klipper's psd_xyz
+    # rises 12.0 then 4.0 dB there): found by benches/reference/sweep_random.py --hard (seed 7,
+    # machine r22); the raw recording (43 s) is not kept
+    c.append(dict(name="short36x123", axis="y", rate=3200.0, seed=5022, noise=396.9,
+                  modes=[mode(47.78, 0.0155, 0.0), mode(94.44, 0.067, -4.73)],
+                  excitation=exc(35.8, 122.8, hps=2.0), outputs=["resonances"],
+                  note="a short sweep 35.8-122.8 Hz at 2 Hz/s, noise 397 mm/s^2; its start "
+                       "a cliff split over two bins"))
     c.append(dict(name="noisy47", axis="y", rate=3200.0, seed=208, noise=400.0,
                   modes=[mode(47.3, 0.08, 14.0)], excitation=FULL, outputs=["resonances"],
                   note="single mode, noise 400 mm/s^2 (PSD floor ~100); " + full))
