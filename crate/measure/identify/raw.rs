@@ -298,6 +298,52 @@ pub(super) fn sweep_stage(
 /// varies on), and the fit must find them resolved (identify/mod.rs). The prominence is read
 /// on the periodogram from its second bin (below the search band too: the spectrum rising
 /// towards a mode near the band's start is its flank, not its base).
+/// The fundamental of Klipper's slow sweep in a sweep's periodogram, Hz, if it shows one
+/// (klippy/extras/resonance_tester.py, `SweepingVibrationsTestGenerator`: a square wave of
+/// ±`sweeping_accel` with period `sweeping_period`, 1.2 s by default, added to the test's
+/// moves so that the toolhead drifts over the test point). Its lines stand at the odd
+/// multiples of 1/P, steady through the record: below a sweep's band they look like narrow
+/// modes rung by its start (a 16 s sweep from 44.8 Hz at noise 424 mm/s²: the 17th, 14.15 Hz,
+/// 11 dB over the floor, was read as a 14.4 Hz, ζ 0.008 mode). Found as the highest bin in
+/// 0.3–2.5 Hz whose 3rd and 5th multiples are peaks too (≥ 6 dB over the median of ±10 bins
+/// around them), refined through the 9th, 17th and 33rd while those stand out as well.
+fn slow_sweep_comb(psd: &Psd) -> Option<f64> {
+    let df = psd.resolution_hz;
+    let p = &psd.psd;
+    let n = p.len();
+    let bin = |f: f64| (f / df).round() as usize;
+    let (a, b) = (bin(0.3).max(1), bin(2.5).min(n.saturating_sub(1)));
+    if b <= a + 2 {
+        return None;
+    }
+    let k1 = (a..=b).max_by(|&x, &y| p[x].total_cmp(&p[y]))?;
+    // The peak within ±2 bins of `f`, if it stands ≥ 6 dB over the median of ±10 bins.
+    let line = |f: f64| -> Option<f64> {
+        let c = bin(f);
+        if c < 12 || c + 12 >= n {
+            return None;
+        }
+        let k = (c - 2..=c + 2).max_by(|&x, &y| p[x].total_cmp(&p[y]))?;
+        let mut around: Vec<f64> = (k - 10..=k + 10)
+            .filter(|&j| j + 1 < k || j > k + 1)
+            .map(|j| p[j])
+            .collect();
+        around.sort_by(f64::total_cmp);
+        (p[k] >= 10f64.powf(0.6) * around[around.len() / 2]).then_some(k as f64 * df)
+    };
+    let mut f1 = k1 as f64 * df;
+    for m in [3.0, 5.0] {
+        f1 = line(m * f1)? / m;
+    }
+    for m in [9.0, 17.0, 33.0] {
+        match line(m * f1) {
+            Some(f) => f1 = f / m,
+            None => break,
+        }
+    }
+    Some(f1)
+}
+
 fn start_peaks(
     psd: &Psd,
     sweep: Sweep,
@@ -328,9 +374,18 @@ fn start_peaks(
         (2 * h + 1) as f64 * df,
         options,
     );
+    let comb = slow_sweep_comb(psd);
+    let on_comb = |f: f64| {
+        comb.is_some_and(|f1| {
+            let m = (f / f1 - 1.0) / 2.0;
+            let odd = 2.0 * m.round().max(0.0) + 1.0;
+            (f - odd * f1).abs() <= 2.0 * df
+        })
+    };
     unique(&peaks, &widths)
         .into_iter()
         .filter(|(_, hp)| hp.width_hz <= widest && hp.peak_hz < fit_band[0])
+        .filter(|(_, hp)| !on_comb(hp.peak_hz))
         .map(|(peak, half)| {
             let reach = (3.0 * half.width_hz).max(6.0 * df);
             Local {
@@ -379,4 +434,77 @@ pub(super) fn free_decay_stage(signal: &[f64], fs: f64, slots: &mut [Slot]) -> O
         end_s: end as f64 / fs,
         level_db,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The whole-record periodogram `sweep_stage` reads.
+    fn periodogram(x: &[f64], fs: f64) -> Psd {
+        welch(
+            x,
+            &WelchOptions {
+                sample_rate_hz: fs,
+                segment_length: Some(x.len()),
+                overlap: Some(0),
+                window: WindowKind::Rectangular,
+                kaiser_beta: 6.0,
+                symmetric_window: false,
+                detrend: Detrend::Linear,
+                scaling: Scaling::Density,
+            },
+        )
+        .unwrap()
+    }
+
+    /// 16.5 s at 3.2 kHz of white noise (σ ≈ 424 mm/s², a fixed linear congruential
+    /// sequence) plus, when `square`, Klipper's slow sweep: ±400 mm/s², period 1.2 s, its
+    /// switches at P√2/8, then P(√2/8 + 1/4) later, then every P/2 (resonance_tester.py).
+    fn record(square: bool, tone_hz: Option<f64>) -> (Vec<f64>, f64) {
+        let (fs, n) = (3200.0, 52_800);
+        let p = 1.2;
+        let first = p * 2f64.sqrt() / 8.0;
+        let mut state = 777u64;
+        let x = (0..n)
+            .map(|i| {
+                let t = i as f64 / fs;
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let u = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                let second = first + p * (2f64.sqrt() / 8.0 + 0.25);
+                let switches = if t < first {
+                    0
+                } else if t < second {
+                    1
+                } else {
+                    2 + ((t - second) / (p / 2.0)).floor() as i64
+                };
+                let sq = if switches % 2 == 0 { 400.0 } else { -400.0 };
+                let tone =
+                    tone_hz.map_or(0.0, |f| 60.0 * (2.0 * std::f64::consts::PI * f * t).sin());
+                1470.0 * u + if square { sq } else { 0.0 } + tone
+            })
+            .collect();
+        (x, fs)
+    }
+
+    /// The slow sweep's comb is found at 1/1.2 s (to a fifth of a bin of the whole record:
+    /// its 33rd line within 2 bins); noise alone, or with one steady tone, has none.
+    #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
+    fn finds_the_slow_sweeps_comb_and_nothing_else() {
+        let (x, fs) = record(true, None);
+        let psd = periodogram(&x, fs);
+        let f1 = slow_sweep_comb(&psd).expect("the comb");
+        assert!(
+            (f1 - 1.0 / 1.2).abs() < 0.2 * psd.resolution_hz,
+            "{f1} against {}",
+            1.0 / 1.2
+        );
+        let (x, fs) = record(false, None);
+        assert_eq!(slow_sweep_comb(&periodogram(&x, fs)), None);
+        let (x, fs) = record(false, Some(1.1));
+        assert_eq!(slow_sweep_comb(&periodogram(&x, fs)), None);
+    }
 }
