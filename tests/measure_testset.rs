@@ -100,6 +100,17 @@ impl Tally {
         }
     }
 
+    /// The rows (only the misses when `only_failed`), then the count.
+    fn print(&self, only_failed: bool) {
+        self.print_rows(only_failed);
+        println!(
+            "{} of {} modes within the targets, {} spurious",
+            self.within(),
+            self.rows.len(),
+            self.spurious.len()
+        );
+    }
+
     fn print_rows(&self, only_failed: bool) {
         println!(
             "{:<18} {:<12} {:>8} {:>6}   {:>8} {:>7} {:>7} {:>7}  ok",
@@ -265,13 +276,7 @@ fn every_case_of_the_independent_test_set() {
         let t = tally(&manifest, max_modes);
         println!("\n{label}:");
         // The whole table for the true count, the misses and the spurious modes otherwise.
-        t.print_rows(i > 0);
-        println!(
-            "{} of {} modes within the targets, {} spurious",
-            t.within(),
-            t.rows.len(),
-            t.spurious.len()
-        );
+        t.print(i > 0);
         summary.push((label, t.within(), t.rows.len(), t.spurious.len()));
     }
     println!();
@@ -315,13 +320,7 @@ fn random_machines() {
     )
     .unwrap();
     let t = tally_in(&dir, &manifest, &|_| 3);
-    t.print_rows(false);
-    println!(
-        "{} of {} modes within the targets, {} spurious",
-        t.within(),
-        t.rows.len(),
-        t.spurious.len()
-    );
+    t.print(false);
     assert_eq!(t.spurious.len(), 0, "spurious modes");
 }
 
@@ -476,13 +475,7 @@ fn no_spurious_modes_over_noise_draws() {
     }
     for (k, t) in [(20, &t20), (80, &t80)] {
         println!("\n{k} segments:");
-        t.print_rows(false);
-        println!(
-            "{} of {} modes within the targets, {} spurious",
-            t.within(),
-            t.rows.len(),
-            t.spurious.len()
-        );
+        t.print(false);
         assert_eq!(t.spurious.len(), 0, "{k} segments: spurious modes");
     }
     assert!(

@@ -237,20 +237,7 @@ pub(super) fn sweep_stage(
     band: [f64; 2],
     options: &IdentifyOptions,
 ) -> Result<Option<Stage>> {
-    let n = signal.len();
-    let psd = welch(
-        signal,
-        &WelchOptions {
-            sample_rate_hz: fs,
-            segment_length: Some(n),
-            overlap: Some(0),
-            window: WindowKind::Rectangular,
-            kaiser_beta: 6.0,
-            symmetric_window: false,
-            detrend: Detrend::Linear,
-            scaling: Scaling::Density,
-        },
-    )?;
+    let psd = periodogram(signal, fs)?;
     let df = psd.resolution_hz;
     let root = sweep.rate_hz_per_s.sqrt();
     let margin = root.max(4.0 * df);
@@ -298,6 +285,24 @@ pub(super) fn sweep_stage(
 /// varies on), and the fit must find them resolved (identify/mod.rs). The prominence is read
 /// on the periodogram from its second bin (below the search band too: the spectrum rising
 /// towards a mode near the band's start is its flank, not its base).
+/// A sweep's whole-record periodogram (rectangular window, linear detrend): what its stage
+/// reads.
+fn periodogram(signal: &[f64], fs: f64) -> Result<Psd> {
+    welch(
+        signal,
+        &WelchOptions {
+            sample_rate_hz: fs,
+            segment_length: Some(signal.len()),
+            overlap: Some(0),
+            window: WindowKind::Rectangular,
+            kaiser_beta: 6.0,
+            symmetric_window: false,
+            detrend: Detrend::Linear,
+            scaling: Scaling::Density,
+        },
+    )
+}
+
 /// The fundamental of Klipper's slow sweep in a sweep's periodogram, Hz, if it shows one
 /// (klippy/extras/resonance_tester.py, `SweepingVibrationsTestGenerator`: a square wave of
 /// ±`sweeping_accel` with period `sweeping_period`, 1.2 s by default, added to the test's
@@ -440,24 +445,6 @@ pub(super) fn free_decay_stage(signal: &[f64], fs: f64, slots: &mut [Slot]) -> O
 mod tests {
     use super::*;
 
-    /// The whole-record periodogram `sweep_stage` reads.
-    fn periodogram(x: &[f64], fs: f64) -> Psd {
-        welch(
-            x,
-            &WelchOptions {
-                sample_rate_hz: fs,
-                segment_length: Some(x.len()),
-                overlap: Some(0),
-                window: WindowKind::Rectangular,
-                kaiser_beta: 6.0,
-                symmetric_window: false,
-                detrend: Detrend::Linear,
-                scaling: Scaling::Density,
-            },
-        )
-        .unwrap()
-    }
-
     /// 16.5 s at 3.2 kHz of white noise (σ ≈ 424 mm/s², a fixed linear congruential
     /// sequence) plus, when `square`, Klipper's slow sweep: ±400 mm/s², period 1.2 s, its
     /// switches at P√2/8, then P(√2/8 + 1/4) later, then every P/2 (resonance_tester.py).
@@ -495,7 +482,7 @@ mod tests {
     #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
     fn finds_the_slow_sweeps_comb_and_nothing_else() {
         let (x, fs) = record(true, None);
-        let psd = periodogram(&x, fs);
+        let psd = periodogram(&x, fs).unwrap();
         let f1 = slow_sweep_comb(&psd).expect("the comb");
         assert!(
             (f1 - 1.0 / 1.2).abs() < 0.2 * psd.resolution_hz,
@@ -503,8 +490,8 @@ mod tests {
             1.0 / 1.2
         );
         let (x, fs) = record(false, None);
-        assert_eq!(slow_sweep_comb(&periodogram(&x, fs)), None);
+        assert_eq!(slow_sweep_comb(&periodogram(&x, fs).unwrap()), None);
         let (x, fs) = record(false, Some(1.1));
-        assert_eq!(slow_sweep_comb(&periodogram(&x, fs)), None);
+        assert_eq!(slow_sweep_comb(&periodogram(&x, fs).unwrap()), None);
     }
 }
