@@ -272,19 +272,6 @@ pub(super) fn sweep_stage(
     }))
 }
 
-/// The peaks of a sweep's periodogram between the search band's start and the smooth part of
-/// the sweep (`fit_band`), each with the band it is fitted on alone: ± 3 half-power widths
-/// (at least ± 6 bins).
-///
-/// Why alone: near its start a sweep's spectrum is not the smooth ∝ f² of the band (the
-/// chirp's Fresnel ripple, about √r wide, and Klipper's coarse first steps: f rises by
-/// r/(2f) per half period), so one excitation law cannot hold from there to the band's
-/// modes. Over a few half-power widths of a narrow mode it is smooth, and a local power law
-/// stands for it (the joint model of identify/model.rs on that band, one mode). Only peaks
-/// narrower than √r/4 qualify (so the ± 3 widths fitted stay within the scale the excitation
-/// varies on), and the fit must find them resolved (identify/mod.rs). The prominence is read
-/// on the periodogram from its second bin (below the search band too: the spectrum rising
-/// towards a mode near the band's start is its flank, not its base).
 /// A sweep's whole-record periodogram (rectangular window, linear detrend): what its stage
 /// reads.
 fn periodogram(signal: &[f64], fs: f64) -> Result<Psd> {
@@ -349,6 +336,20 @@ fn slow_sweep_comb(psd: &Psd) -> Option<f64> {
     Some(f1)
 }
 
+/// The peaks of a sweep's periodogram between the search band's start and the smooth part of
+/// the sweep (`fit_band`), each with the band it is fitted on alone: ± 3 half-power widths
+/// (at least ± 6 bins).
+///
+/// Why alone: near its start a sweep's spectrum is not the smooth ∝ f² of the band (the
+/// chirp's Fresnel ripple, about √r wide, and Klipper's coarse first steps: f rises by
+/// r/(2f) per half period), so one excitation law cannot hold from there to the band's
+/// modes. Over a few half-power widths of a narrow mode it is smooth, and a local power law
+/// stands for it (the joint model of identify/model.rs on that band, one mode). Only peaks
+/// narrower than √r/4 qualify (so the ± 3 widths fitted stay within the scale the excitation
+/// varies on), and the fit must find them resolved (identify/mod.rs). The prominence is read
+/// on the periodogram from its second bin (below the search band too: the spectrum rising
+/// towards a mode near the band's start is its flank, not its base). A peak within 2 bins of
+/// a line of the slow sweep's comb ([`slow_sweep_comb`]) is none.
 fn start_peaks(
     psd: &Psd,
     sweep: Sweep,
