@@ -7,7 +7,9 @@
 //! spectrum shows something must never read as "no mode" without a word): the figures go to
 //! docs/measured-data.md (*On real recordings*).
 
-use input_shaping::measure::identify::{identify_spectrum, IdentifyOptions};
+use input_shaping::measure::identify::{
+    identify, identify_spectrum, Identification, IdentifyOptions,
+};
 use input_shaping::measure::recording::{parse_file, Parsed};
 use input_shaping::measure::RecordingOptions;
 
@@ -32,11 +34,15 @@ fn identify_real_files() {
             file_name: Some(name.clone()),
             ..RecordingOptions::default()
         };
-        let Ok(Parsed::Spectrum(sf)) = parse_file(&text, &options) else {
-            println!("{name}: not a spectrum file");
-            continue;
-        };
-        let id = identify_spectrum(&sf, &IdentifyOptions::default()).unwrap();
+        let id = match parse_file(&text, &options) {
+            Ok(Parsed::Spectrum(sf)) => identify_spectrum(&sf, &IdentifyOptions::default()),
+            Ok(Parsed::Recording(r)) => identify_raw(&name, &r),
+            Err(e) => {
+                println!("{name}: not read: {e}");
+                continue;
+            }
+        }
+        .unwrap();
         let modes: Vec<String> = id
             .modes
             .iter()
@@ -48,8 +54,12 @@ fn identify_real_files() {
             })
             .collect();
         println!(
-            "{name}: modes [{}]; sweep end {}; cut off {}",
+            "{name}: modes [{}]; sweep {}; sweep end {}; cut off {}",
             modes.join(", "),
+            id.sweep.map_or("none".to_string(), |s| format!(
+                "{:.1}–{:.1} Hz",
+                s.band_hz[0], s.band_hz[1]
+            )),
             id.sweep_end_hz
                 .map_or("none".to_string(), |f| format!("{f:.1} Hz")),
             id.cut_off.map_or("none".to_string(), |c| format!(
@@ -65,4 +75,18 @@ fn identify_real_files() {
         }
     }
     assert!(silent.is_empty(), "no mode and no note: {silent:?}");
+}
+
+/// A raw recording (Klipper's `raw_data_<axis>_…csv`): the channel of the axis its name gives
+/// (`x` when it names none), identified with the defaults but for the sample rate.
+fn identify_raw(
+    name: &str,
+    r: &input_shaping::measure::recording::Recording,
+) -> input_shaping::error::Result<Identification> {
+    let axis = ["x", "y", "z"]
+        .into_iter()
+        .find(|a| name.contains(&format!("_{a}_")))
+        .unwrap_or("x");
+    let x = &r.channel(&format!("accel_{axis}")).unwrap().values;
+    identify(x, &IdentifyOptions::new(r.sample_rate_hz))
 }

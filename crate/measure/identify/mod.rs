@@ -149,7 +149,7 @@ fn joint_fit(
     let fitted = fit_modes(input, &seeds, max_modes)?;
     let end = input.sweep_end_hz.unwrap_or(f64::INFINITY);
     // Stands 3 dB or more over the model without it at the band's top: the end needs it.
-    let mut past_fit = if fitted.top_db.get(past).is_some_and(|&db| db >= 3.0) {
+    let mut past_fit = if beyond.is_some() && fitted.top_db.get(past).is_some_and(|&db| db >= 3.0) {
         PastFit::Needed
     } else {
         PastFit::NotNeeded
@@ -188,6 +188,36 @@ fn joint_fit(
         }
     }
     Some(past_fit)
+}
+
+/// Whether a response rising into a sweep's end (its top at `top_hz`) is reported as cut off,
+/// given what the joint fit made of the mode seeded past the end: not when the fit held it
+/// under the end; yes when the end needed it; otherwise yes unless a seeded peak lies within
+/// `near_hz` of the top (a mode just under the end explains it).
+fn cut_off(past: Option<PastFit>, halves: &[HalfPower], top_hz: f64, near_hz: f64) -> bool {
+    match past {
+        Some(PastFit::Held) => false,
+        Some(PastFit::Needed) => true,
+        _ => !halves.iter().any(|h| (h.peak_hz - top_hz).abs() <= near_hz),
+    }
+}
+
+/// The user's note for [`Identification::cut_off`], when there is one.
+fn note_cut_off(result: &mut Identification) {
+    if let Some(c) = result.cut_off {
+        result.notes.push(format!(
+            "The response still rises where the sweep ends ({:.1} Hz, {:.0} dB over its left \
+             flank): a mode peaks near or past the end, its frequency and damping cannot be \
+             read from this {}. Re-run the test with a higher maximum frequency.",
+            c.frequency_hz,
+            c.prominence_db,
+            if result.sweep.is_some() {
+                "recording"
+            } else {
+                "file"
+            }
+        ));
+    }
 }
 
 /// What became of the mode seeded past the band's top ([`joint_fit`]).
@@ -411,8 +441,9 @@ pub struct Identification {
     /// A spectrum file's sweep end, when its PSD shows one (the last bin fitted before the
     /// cliff), Hz; `None` otherwise and for recordings.
     pub sweep_end_hz: Option<f64>,
-    /// A response still rising where a spectrum file's sweep ends: a mode peaking near or
-    /// past [`CutOff::frequency_hz`], whose peak the file does not hold. Not one of `modes` (its
+    /// A response still rising where the sweep ends (a spectrum file's cliff, or a raw
+    /// recording's detected sweep): a mode peaking near or past [`CutOff::frequency_hz`],
+    /// whose peak the data do not hold. Not one of `modes` (its
     /// frequency is only a lower bound, its damping unknown: nothing to design a shaper for),
     /// but reported so that such a file does not come out as "no mode". `None` otherwise.
     pub cut_off: Option<CutOff>,
@@ -421,12 +452,13 @@ pub struct Identification {
     pub notes: Vec<String>,
 }
 
-/// A response cut off by the end of a spectrum file's sweep ([`Identification::cut_off`]).
+/// A response cut off by the end of a sweep ([`Identification::cut_off`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "camelCase")]
 pub struct CutOff {
-    /// The last bin fitted before the sweep's cliff, Hz: the mode peaks near it (within the
-    /// window's smear of the cliff, ±2 bins) or past it.
+    /// Where the sweep ends, Hz: for a spectrum file the last bin fitted before the sweep's
+    /// cliff (the mode peaks near it, within the window's smear of the cliff, ±2 bins, or past
+    /// it); for a raw recording the end of its detected sweep ([`Sweep::band_hz`]).
     pub frequency_hz: f64,
     /// How far the response rises to it over the lowest point of its left flank (down to the
     /// nearest higher bin or the band's start), dB.
@@ -481,6 +513,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         found,
         band,
         local,
+        rising,
     } = stage;
     let halves: Vec<HalfPower> = found.iter().map(|(_, h)| *h).collect();
     let mut slots: Vec<Slot> = found
@@ -511,9 +544,31 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         kind: options.signal,
         enbw_bins: psd.enbw_bins,
         band,
-        sweep_end_hz: None,
+        sweep_end_hz: result.sweep.map(|s| s.band_hz[1]),
     };
-    let joint = joint_fit(&input, &halves, None, options.max_modes, &mut slots);
+    // A response rising into a sweep's end: as for a spectrum file's cliff
+    // (`identify_spectrum`), a mode seeded past the band, reported as cut off unless the fit
+    // holds it under the end.
+    let beyond = rising.map(|r| {
+        let seed = Seed {
+            frequency_hz: 1.05 * band[1],
+            damping: 0.05,
+            peak_psd: r.level,
+            peak: None,
+        };
+        (seed, psd.frequency_hz[r.top])
+    });
+    let joint = joint_fit(&input, &halves, beyond, options.max_modes, &mut slots);
+    if let (Some(r), Some(s)) = (rising, result.sweep) {
+        // Within the stretch the top was taken from (`raw::rising_into_top`).
+        let near_hz = s.rate_hz_per_s.sqrt().max(2.0 * psd.resolution_hz);
+        let top_hz = psd.frequency_hz[r.top];
+        result.cut_off = cut_off(joint, &halves, top_hz, near_hz).then_some(CutOff {
+            frequency_hz: s.band_hz[1],
+            prominence_db: r.prominence_db,
+        });
+        note_cut_off(&mut result);
+    }
     if joint.is_none() && !halves.is_empty() {
         let bin = |f: f64| ((f / psd.resolution_hz).round() as usize).min(psd.psd.len() - 1);
         let (lo, hi) = (bin(band[0]).max(1), bin(band[1]));
@@ -628,28 +683,13 @@ pub fn identify_spectrum(
         (seed, psd.frequency_hz[top])
     });
     let past = joint_fit(&input, &halves, beyond, options.max_modes, &mut slots);
-    // A cut-off unless the fit held the mode under the end, or did not need it and the
-    // candidate's top is a peak already seeded (a mode a few bins under the end explains it).
     result.cut_off = candidate
-        .filter(|&(_, _, top)| match past {
-            Some(PastFit::Held) => false,
-            Some(PastFit::Needed) => true,
-            _ => !halves
-                .iter()
-                .any(|h| (h.peak_hz - psd.frequency_hz[top]).abs() <= 2.0 * df),
-        })
+        .filter(|&(_, _, top)| cut_off(past, &halves, psd.frequency_hz[top], 2.0 * df))
         .map(|(_, prominence_db, _)| CutOff {
             frequency_hz: f_hi,
             prominence_db,
         });
-    if let Some(c) = result.cut_off {
-        result.notes.push(format!(
-            "The response still rises where the sweep ends ({:.1} Hz, {:.0} dB over its left \
-             flank): a mode peaks near or past the end, its frequency and damping cannot be \
-             read from this file. Re-run the test with a higher maximum frequency.",
-            c.frequency_hz, c.prominence_db
-        ));
-    }
+    note_cut_off(&mut result);
     result.modes = slots.into_iter().map(Slot::into_mode).collect();
     crate::sort::sort_by(&mut result.modes, |a, b| {
         a.frequency_hz.total_cmp(&b.frequency_hz)

@@ -96,3 +96,54 @@ pub(super) fn detect_within(
     crate::sort::sort_by(&mut peaks, |a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     peaks
 }
+
+/// A response rising into the end of `sm` (dB, smoothed, one value per bin): its top, the
+/// highest of the last `last` values, standing `min_db` or more over the lowest point between
+/// it and the nearest higher value on its left (or `sm`'s start) — the topographic prominence
+/// of a peak whose right side is past the end. Returned: that prominence, dB, and the top's
+/// index in `sm`. Used where a sweep's end cuts a response off (a spectrum file's cliff, a raw
+/// sweep's band).
+pub(super) fn rising_into_end(sm: &[f64], last: usize, min_db: f64) -> Option<(f64, usize)> {
+    let n = sm.len();
+    if last == 0 || n <= last {
+        return None;
+    }
+    let (at, top) = (n - last..n).fold((n - 1, f64::NEG_INFINITY), |best, j| {
+        if sm[j] > best.1 {
+            (j, sm[j])
+        } else {
+            best
+        }
+    });
+    let mut low = top;
+    for &v in sm[..n - last].iter().rev() {
+        if v > top {
+            break;
+        }
+        low = low.min(v);
+    }
+    let prominence = top - low;
+    (prominence >= min_db).then_some((prominence, at))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rising_into_end;
+
+    /// A ramp into the end stands its rise; a peak inside with a higher bin on its left is
+    /// measured down to the lowest point after that bin; a falling end is no candidate.
+    #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
+    fn a_rise_into_the_end_and_its_prominence() {
+        let ramp: Vec<f64> = (0..20).map(|k| k as f64).collect();
+        assert_eq!(rising_into_end(&ramp, 3, 6.0), Some((19.0, 19)));
+        // 30 dB at the start, down to 0, up to 10 at the end: 10 dB over the valley.
+        let mut v = vec![30.0, 20.0, 10.0, 0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 9.0];
+        assert_eq!(rising_into_end(&v, 3, 6.0), Some((10.0, 8)));
+        assert_eq!(rising_into_end(&v, 3, 10.5), None);
+        // The top more than `last` values from the end: not rising into it.
+        v.extend([5.0, 2.0, 1.0]);
+        assert_eq!(rising_into_end(&v, 3, 0.5), None);
+        assert_eq!(rising_into_end(&v, 2, 0.5), None);
+        assert_eq!(rising_into_end(&v[..3], 3, 0.0), None);
+    }
+}

@@ -5,19 +5,33 @@
 
 use super::decay::{decay_fit, find_decay};
 use super::half_power::{half_power, smoothed, HalfPower};
-use super::peaks::{detect, detect_within, Peak};
+use super::peaks::{detect, detect_within, rising_into_end, Peak};
 use super::sweep::Sweep;
 use super::{FreeDecay, IdentifyOptions, Slot, MAX_MODES};
 use crate::error::{count, positive, Error, Result};
 use crate::measure::psd::{welch, Detrend, Psd, Scaling, WelchOptions, WindowKind};
 
 /// What the fits start from: the spectrum, its peaks with their half-power seeds (one per
-/// maximum), the band fitted, and peaks fitted each on its own (a sweep's start).
+/// maximum), the band fitted, peaks fitted each on its own (a sweep's start), and a response
+/// still rising into the band's top (a sweep's end).
 pub(super) struct Stage {
     pub psd: Psd,
     pub found: Vec<(Peak, HalfPower)>,
     pub band: [f64; 2],
     pub local: Vec<Local>,
+    pub rising: Option<Rising>,
+}
+
+/// A response still rising into the top of a sweep's fitted band: a mode peaking near or past
+/// the sweep's end (see [`sweep_stage`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Rising {
+    /// How far the top stands over the lowest point of its left flank, dB.
+    pub prominence_db: f64,
+    /// The top's bin.
+    pub top: usize,
+    /// The smoothed PSD there.
+    pub level: f64,
 }
 
 /// A peak below the part of a sweep whose spectrum is smooth, to be fitted alone on `band`
@@ -221,6 +235,7 @@ pub(super) fn welch_stage(
         found,
         band,
         local: Vec::new(),
+        rising: None,
     }))
 }
 
@@ -228,8 +243,12 @@ pub(super) fn welch_stage(
 /// the sensor's drift), searched and fitted inside the swept band less a margin at each end
 /// where the excitation's spectrum is not smooth (a linear chirp's spectrum ripples within
 /// about √r of its ends, r the sweep rate in Hz/s; at least 4 bins). The peaks are those of
-/// the periodogram smoothed over about √r/4. None when the band is empty or nothing stands
-/// out in it (the Welch path then runs).
+/// the periodogram smoothed over about √r/4. A response still rising into the band's top —
+/// the highest smoothed bin within √r of it, standing `minProminenceDb` over
+/// its left flank (`peaks::rising_into_end`) — is returned as [`Rising`]: a mode at or past
+/// the sweep's end (a 138 Hz mode past Klipper's 133.33 Hz), or one just under it whose fall
+/// is not in the band; the joint fit tells which, as for a spectrum file's cliff. None when
+/// the band is empty or nothing stands out in it (the Welch path then runs).
 pub(super) fn sweep_stage(
     signal: &[f64],
     fs: f64,
@@ -261,7 +280,8 @@ pub(super) fn sweep_stage(
     let widths = half_powers(&psd, &peaks, fit_band, (2 * h + 1) as f64 * df, options);
     let found = unique(&peaks, &widths);
     let local = start_peaks(&psd, sweep, band, fit_band, h, options);
-    if found.is_empty() && local.is_empty() {
+    let rising = rising_into_top(&psd, lo, hi, h, root, options.min_prominence_db);
+    if found.is_empty() && local.is_empty() && rising.is_none() {
         return Ok(None);
     }
     Ok(Some(Stage {
@@ -269,7 +289,42 @@ pub(super) fn sweep_stage(
         found,
         band: fit_band,
         local,
+        rising,
     }))
+}
+
+/// [`Rising`] on bins `lo..=hi` of a sweep's periodogram smoothed over ±`h` bins in dB (as
+/// the peaks are found), the top within the last `width_hz` (√r, as the band's margin: the
+/// chirp's spectrum still ripples by a dB or two there, and the smoothed bins scatter as
+/// much: a 72 Hz mode past a 70 Hz end rose 11 dB over the last 10 Hz fitted, its top 0.7 Hz
+/// under the band's end) and at least 2h + 1 bins.
+fn rising_into_top(
+    psd: &Psd,
+    lo: usize,
+    hi: usize,
+    h: usize,
+    width_hz: f64,
+    min_db: f64,
+) -> Option<Rising> {
+    let db: Vec<f64> = psd.psd[lo..=hi]
+        .iter()
+        .map(|p| 10.0 * p.max(1e-300).log10())
+        .collect();
+    let n = db.len();
+    let sm: Vec<f64> = (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(h), (i + h).min(n - 1));
+            db[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
+        })
+        .collect();
+    let last = ((width_hz / psd.resolution_hz).round() as usize).max(2 * h + 1);
+    let (prominence_db, at) = rising_into_end(&sm, last, min_db)?;
+    let top = lo + at;
+    Some(Rising {
+        prominence_db,
+        top,
+        level: smoothed(psd, h).psd[top],
+    })
 }
 
 /// A sweep's whole-record periodogram (rectangular window, linear detrend): what its stage

@@ -3,7 +3,7 @@
 
 use super::half_power::{half_power, HalfPower};
 use super::model::WindowSpec;
-use super::peaks::detect_within;
+use super::peaks::{detect_within, rising_into_end};
 use super::{IdentifyOptions, Slot};
 use crate::error::{count, positive, Error, Result};
 use crate::measure::psd::{window, Psd, WindowKind, MAX_SEGMENT_LENGTH};
@@ -309,22 +309,5 @@ pub(super) fn rising_to_end(
     if cut < lo + 4 {
         return None;
     }
-    let sm = smoothed_db(grid, lo, cut);
-    let c = sm.len() - 1;
-    let (at, top) = (c - 2..=c).fold((c, f64::NEG_INFINITY), |best, j| {
-        if sm[j] > best.1 {
-            (j, sm[j])
-        } else {
-            best
-        }
-    });
-    let mut low = top;
-    for &v in sm[..c - 2].iter().rev() {
-        if v > top {
-            break;
-        }
-        low = low.min(v);
-    }
-    let prominence = top - low;
-    (prominence >= min_db).then_some((prominence, lo + at))
+    rising_into_end(&smoothed_db(grid, lo, cut), 3, min_db).map(|(p, at)| (p, lo + at))
 }
