@@ -461,8 +461,8 @@ mod serde_json_like {
 /// sweep read from a raw recording, whose modes were then fitted on its whole-record
 /// periodogram; `null` otherwise. `sweepEndHz`: a spectrum file's sweep end, the last bin
 /// fitted before its cliff, or `null`. `cutOff: { frequencyHz, prominenceDb } | null`: a
-/// response still rising there, a mode peaking near or past `frequencyHz` that the file does not hold
-/// (not in `modes`). `notes`: what could not be identified, in words for the user).
+/// response still rising there (or at a raw recording's `sweep` end), a mode peaking near or
+/// past `frequencyHz` that the data do not hold (not in `modes`). `notes`: what could not be identified, in words for the user).
 #[cfg(feature = "js-recording")]
 #[wasm_bindgen(js_name = identifyModes, unchecked_return_type = "Identification")]
 pub fn identify_modes(

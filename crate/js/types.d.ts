@@ -775,8 +775,9 @@ export interface Identification {
   sweep: { bandHz: [number, number]; rateHzPerS: number } | null;
   /** A spectrum file's sweep end (the last bin fitted before its cliff), Hz, or `null`. */
   sweepEndHz: number | null;
-  /** A response still rising where the sweep ends: a mode peaking near or past `frequencyHz`
-   * that the file does not hold (its damping unknown; not one of `modes`), or `null`. */
+  /** A response still rising where the sweep ends (a spectrum file's cliff, or the end of a
+   * raw recording's `sweep`): a mode peaking near or past `frequencyHz` that the data do not
+   * hold (its damping unknown; not one of `modes`), or `null`. */
   cutOff: { frequencyHz: number; prominenceDb: number } | null;
   /** What could not be identified, in words for the user (may be empty). */
   notes: string[];
