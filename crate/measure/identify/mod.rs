@@ -551,7 +551,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
     // holds it under the end.
     let beyond = rising.map(|r| {
         let seed = Seed {
-            frequency_hz: 1.05 * band[1],
+            frequency_hz: r.seed_hz,
             damping: 0.05,
             peak_psd: r.level,
             peak: None,

@@ -9,23 +9,12 @@ pub(super) struct Peak {
     pub(super) prominence_db: f64,
 }
 
-/// Local maxima of the dB spectrum smoothed over 2h + 1 bins in bins `lo..=hi`, with their
-/// topographic prominence (height over the higher of the lowest points between it and a higher
-/// point on each side, or the band's end).
-pub(super) fn detect(
-    psd: &Psd,
-    lo: usize,
-    hi: usize,
-    min_db: f64,
-    max_modes: usize,
-    h: usize,
-) -> Vec<Peak> {
-    detect_within(psd, [lo, hi], [lo, hi], min_db, max_modes, h)
-}
-
-/// [`detect`] with the peaks in bins `band[0]..=band[1]` but the smoothing and the prominence
-/// read over the wider `context` (the spectrum around the band: a peak near the band's end
-/// then keeps its flank beyond it, instead of the end standing for its base).
+/// Local maxima of the dB spectrum smoothed over 2h + 1 bins, in bins `band[0]..=band[1]`, with
+/// their topographic prominence (height over the higher of the lowest points between it and a
+/// higher point on each side, or the context's end), the `max_modes` most prominent. The
+/// smoothing and the prominence are read over `context`, which may be wider than the band
+/// (the spectrum around it: a peak near the band's end then keeps its flank beyond it,
+/// instead of the end standing for its base).
 pub(super) fn detect_within(
     psd: &Psd,
     band: [usize; 2],

@@ -5,7 +5,7 @@
 
 use super::decay::{decay_fit, find_decay};
 use super::half_power::{half_power, smoothed, HalfPower};
-use super::peaks::{detect, detect_within, rising_into_end, Peak};
+use super::peaks::{detect_within, rising_into_end, Peak};
 use super::sweep::Sweep;
 use super::{FreeDecay, IdentifyOptions, Slot, MAX_MODES};
 use crate::error::{count, positive, Error, Result};
@@ -32,6 +32,9 @@ pub(super) struct Rising {
     pub top: usize,
     /// The smoothed PSD there.
     pub level: f64,
+    /// Where the fit's extra mode is seeded, Hz: past the band for a rise into its top, the
+    /// peak's own frequency for a peak whose high side the end cuts.
+    pub seed_hz: f64,
 }
 
 /// A peak below the part of a sweep whose spectrum is smooth, to be fitted alone on `band`
@@ -247,7 +250,9 @@ pub(super) fn welch_stage(
 /// the highest smoothed bin within √r of it, standing `minProminenceDb` over
 /// its left flank (`peaks::rising_into_end`) — is returned as [`Rising`]: a mode at or past
 /// the sweep's end (a 138 Hz mode past Klipper's 133.33 Hz), or one just under it whose fall
-/// is not in the band; the joint fit tells which, as for a spectrum file's cliff. None when
+/// is not in the band; so is, when there is no such rise, a peak that does not fall 3 dB
+/// before the band's top (56.8 Hz, ζ 0.06, swept to 62.1 Hz); the joint fit tells which, as
+/// for a spectrum file's cliff. None when
 /// the band is empty or nothing stands out in it (the Welch path then runs).
 pub(super) fn sweep_stage(
     signal: &[f64],
@@ -269,18 +274,53 @@ pub(super) fn sweep_stage(
         return Ok(None);
     }
     let h = ((0.125 * root / df).round() as usize).clamp(1, 200);
-    let peaks = detect(
+    // The peaks' prominence is read on through the sweep's end to the searched band's top
+    // (past the end the periodogram falls to the floor: a peak just under the end keeps its
+    // left side's prominence instead of needing a 6 dB fall inside the band); a peak is kept
+    // when the smoothed periodogram falls ≥ 3 dB between it and the band's top (its high
+    // half-power point is fitted), as for a spectrum file's cliff (`spectrum::seeds`); a
+    // response still rising there is `rising`'s.
+    let context_hi = bins(&psd, band).1.max(hi);
+    let sm = smoothed_db(&psd, lo, hi, h);
+    let (mut peaks, shoulders): (Vec<Peak>, Vec<Peak>) = detect_within(
         &psd,
-        lo,
-        hi,
+        [lo, hi],
+        [lo, context_hi],
         options.min_prominence_db,
-        options.max_modes,
+        MAX_MODES + 1,
         h,
-    );
+    )
+    .into_iter()
+    .partition(|p| {
+        let k = ((p.frequency_hz / df).round() as usize).clamp(lo, hi) - lo;
+        let low = sm[k..].iter().cloned().fold(f64::INFINITY, f64::min);
+        low <= sm[k] - 3.0
+    });
+    crate::sort::sort_by(&mut peaks, |a, b| {
+        b.prominence_db.total_cmp(&a.prominence_db)
+    });
+    peaks.truncate(options.max_modes);
+    crate::sort::sort_by(&mut peaks, |a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     let widths = half_powers(&psd, &peaks, fit_band, (2 * h + 1) as f64 * df, options);
     let found = unique(&peaks, &widths);
     let local = start_peaks(&psd, sweep, band, fit_band, h, options);
-    let rising = rising_into_top(&psd, lo, hi, h, root, options.min_prominence_db);
+    // Rising into the top, or else the highest peak without its 3 dB fall (a mode whose high
+    // side the band's end cuts: seeded at its own frequency, a mode if the fit holds it).
+    let rising = rising_into_top(&psd, &sm, lo, h, root, options.min_prominence_db)
+        .map(|r| Rising {
+            seed_hz: 1.05 * fit_band[1],
+            ..r
+        })
+        .or_else(|| {
+            let p = shoulders.last()?;
+            let top = ((p.frequency_hz / df).round() as usize).clamp(lo, hi);
+            Some(Rising {
+                prominence_db: p.prominence_db,
+                top,
+                level: smoothed(&psd, h).psd[top],
+                seed_hz: p.frequency_hz,
+            })
+        });
     if found.is_empty() && local.is_empty() && rising.is_none() {
         return Ok(None);
     }
@@ -293,37 +333,43 @@ pub(super) fn sweep_stage(
     }))
 }
 
-/// [`Rising`] on bins `lo..=hi` of a sweep's periodogram smoothed over ±`h` bins in dB (as
-/// the peaks are found), the top within the last `width_hz` (√r, as the band's margin: the
-/// chirp's spectrum still ripples by a dB or two there, and the smoothed bins scatter as
-/// much: a 72 Hz mode past a 70 Hz end rose 11 dB over the last 10 Hz fitted, its top 0.7 Hz
-/// under the band's end) and at least 2h + 1 bins.
-fn rising_into_top(
-    psd: &Psd,
-    lo: usize,
-    hi: usize,
-    h: usize,
-    width_hz: f64,
-    min_db: f64,
-) -> Option<Rising> {
+/// The periodogram in dB on bins `lo..=hi`, averaged over ±`h` bins within them (as the
+/// peaks are found), indexed from `lo`.
+fn smoothed_db(psd: &Psd, lo: usize, hi: usize, h: usize) -> Vec<f64> {
     let db: Vec<f64> = psd.psd[lo..=hi]
         .iter()
         .map(|p| 10.0 * p.max(1e-300).log10())
         .collect();
     let n = db.len();
-    let sm: Vec<f64> = (0..n)
+    (0..n)
         .map(|i| {
             let (a, b) = (i.saturating_sub(h), (i + h).min(n - 1));
             db[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
         })
-        .collect();
+        .collect()
+}
+
+/// [`Rising`] on `sm`, a sweep's periodogram on bins `lo..` smoothed over ±`h` bins in dB
+/// ([`smoothed_db`]), the top within the last `width_hz` (√r, as the band's margin: the
+/// chirp's spectrum still ripples by a dB or two there, and the smoothed bins scatter as
+/// much: a 72 Hz mode past a 70 Hz end rose 11 dB over the last 10 Hz fitted, its top 0.7 Hz
+/// under the band's end) and at least 2h + 1 bins.
+fn rising_into_top(
+    psd: &Psd,
+    sm: &[f64],
+    lo: usize,
+    h: usize,
+    width_hz: f64,
+    min_db: f64,
+) -> Option<Rising> {
     let last = ((width_hz / psd.resolution_hz).round() as usize).max(2 * h + 1);
-    let (prominence_db, at) = rising_into_end(&sm, last, min_db)?;
+    let (prominence_db, at) = rising_into_end(sm, last, min_db)?;
     let top = lo + at;
     Some(Rising {
         prominence_db,
         top,
         level: smoothed(psd, h).psd[top],
+        seed_hz: f64::NAN,
     })
 }
 
