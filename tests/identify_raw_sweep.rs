@@ -191,7 +191,7 @@ fn raw_sweep_ends() {
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(format!("{dir}/manifest.json")).unwrap())
             .unwrap();
-    let (mut inside, mut within, mut spurious, mut past, mut reported) = (0, 0, 0, 0, 0);
+    let (mut inside, mut good, mut spurious, mut past, mut reported) = (0, 0, 0, 0, 0);
     let mut spurious_on_sweeps = 0;
     for case in manifest.as_array().unwrap() {
         let name = case["name"].as_str().unwrap();
@@ -216,7 +216,7 @@ fn raw_sweep_ends() {
             let ok = id.modes.iter().any(|m| within(m, f, z));
             if f * (1.0 + z) < end - 2f64.sqrt() {
                 inside += 1;
-                within += usize::from(ok);
+                good += usize::from(ok);
                 line.push(format!(
                     "{f:.1}/{z:.3} inside {}",
                     if ok { "ok" } else { "MISSED" }
@@ -261,7 +261,7 @@ fn raw_sweep_ends() {
         );
     }
     println!(
-        "{within} of {inside} modes inside the band within the targets, {spurious} spurious; \
+        "{good} of {inside} modes inside the band within the targets, {spurious} spurious; \
          {reported} of {past} recordings with a mode past the end report it cut off"
     );
     assert_eq!(spurious_on_sweeps, 0);

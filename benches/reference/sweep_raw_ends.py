@@ -11,7 +11,13 @@ times the lowest mode to 0.9-1.25 times the highest; noise 150-400 mm/s^2.  Writ
 raw CSV (`raw_data_x_eNN.csv`) and `manifest.json` ({name, modes: [[f, zeta]], start, end}):
 
     python3 benches/reference/sweep_raw_ends.py OUT [N] [SEED]
+    python3 benches/reference/sweep_raw_ends.py OUT --flat
     SWEEP_RAW_ENDS_DIR=OUT cargo test --release --test identify_raw_sweep -- --ignored --nocapture
+
+With --flat, four fixed recordings whose swept band holds no mode instead: a mode far past
+the end (250 Hz swept 30-80 Hz, 300 Hz swept 20-120 Hz, 260 Hz swept 5-60 Hz) or far below
+the start (8 Hz swept 30-80 Hz, where the response in the band is flat and only the
+periodogram's wiggles stand out).
 
 numpy + scipy.
 """
@@ -54,7 +60,31 @@ def main(out, n, seed):
         json.dump(manifest, fh, indent=1)
 
 
+FLAT = [([(250.0, 0.05, 0.0)], 30.0, 80.0), ([(300.0, 0.03, 0.0)], 20.0, 120.0),
+        ([(8.0, 0.05, 0.0)], 30.0, 80.0), ([(260.0, 0.05, 0.0)], 5.0, 60.0)]
+
+
+def flat(out):
+    os.makedirs(out, exist_ok=True)
+    manifest = []
+    for i, (modes, start, end) in enumerate(FLAT):
+        name = "e%02d" % i
+        case = dict(name=name, axis="x", rate=3200.0, seed=700 + i, noise=200.0,
+                    modes=[st.mode(*m) for m in modes], excitation=st.exc(start, end, hps=2.0),
+                    outputs=["raw"], note="")
+        st.normalize_gains(case["modes"])
+        case.setdefault("drift", dict(st.DRIFT))
+        st.write_files(case, out)
+        manifest.append(dict(name=name, modes=[[m["f"], m["zeta"]] for m in case["modes"]],
+                             start=start, end=end))
+    with open(os.path.join(out, "manifest.json"), "w") as fh:
+        json.dump(manifest, fh, indent=1)
+
+
 if __name__ == "__main__":
+    if "--flat" in sys.argv[1:]:
+        flat(next((a for a in sys.argv[1:] if a != "--flat"), "/tmp/raw_flat"))
+        sys.exit(0)
     args = sys.argv[1:]
     main(args[0] if args else "/tmp/raw_ends", int(args[1]) if len(args) > 1 else 20,
          int(args[2]) if len(args) > 2 else 3)

@@ -247,7 +247,7 @@ pub(super) fn welch_stage(
 /// where the excitation's spectrum is not smooth (a linear chirp's spectrum ripples within
 /// about √r of its ends, r the sweep rate in Hz/s; at least 4 bins). The peaks are those of
 /// the periodogram smoothed over about √r/4. A response still rising into the band's top —
-/// the highest smoothed bin within √r of it, standing `minProminenceDb` over
+/// the highest bin of the periodogram smoothed over about √r within √r of it, standing `minProminenceDb` over
 /// its left flank (`peaks::rising_into_end`) — is returned as [`Rising`]: a mode at or past
 /// the sweep's end (a 138 Hz mode past Klipper's 133.33 Hz), or one just under it whose fall
 /// is not in the band; so is, when there is no such rise, a peak that does not fall 3 dB
@@ -274,39 +274,61 @@ pub(super) fn sweep_stage(
         return Ok(None);
     }
     let h = ((0.125 * root / df).round() as usize).clamp(1, 200);
-    // The peaks' prominence is read on through the sweep's end to the searched band's top
-    // (past the end the periodogram falls to the floor: a peak just under the end keeps its
-    // left side's prominence instead of needing a 6 dB fall inside the band); a peak is kept
-    // when the smoothed periodogram falls ≥ 3 dB between it and the band's top (its high
-    // half-power point is fitted), as for a spectrum file's cliff (`spectrum::seeds`); a
-    // response still rising there is `rising`'s.
+    // Peaks standing out on both sides inside the band; then peaks whose high side the band's
+    // end cuts, their prominence read on through the sweep's end (past it the periodogram falls
+    // to the floor) on the periodogram smoothed 4 times as heavily: one side's 6 dB must not be
+    // one dip of the noise (a 2h + 1-bin mean of the periodogram scatters ~2 dB, and its
+    // lowest over thousands of bins lies 6–7 dB under its mean: a sweep over a band with no
+    // mode, the response at the noise floor, read a 74 Hz mode so). Those are kept when the
+    // smoothed periodogram falls ≥ 3 dB between them and the band's top (their high
+    // half-power point is fitted), as for a spectrum file's cliff (`spectrum::seeds`); the
+    // others are shoulders. A response still rising into the top is `rising`'s.
+    let h2 = (4 * h).min(800);
+    let heavy = smoothed_db(&psd, lo, hi, h2);
+    let mut peaks = detect_within(
+        &psd,
+        [lo, hi],
+        [lo, hi],
+        options.min_prominence_db,
+        options.max_modes,
+        h,
+    );
+    let reach = (2 * h2 + 1) as f64 * df;
     let context_hi = bins(&psd, band).1.max(hi);
-    let sm = smoothed_db(&psd, lo, hi, h);
-    let (mut peaks, shoulders): (Vec<Peak>, Vec<Peak>) = detect_within(
+    let (edge, shoulders): (Vec<Peak>, Vec<Peak>) = detect_within(
         &psd,
         [lo, hi],
         [lo, context_hi],
         options.min_prominence_db,
-        MAX_MODES + 1,
-        h,
+        MAX_MODES,
+        h2,
     )
     .into_iter()
+    .filter(|p| {
+        peaks
+            .iter()
+            .all(|q| (q.frequency_hz - p.frequency_hz).abs() > reach)
+    })
     .partition(|p| {
         let k = ((p.frequency_hz / df).round() as usize).clamp(lo, hi) - lo;
-        let low = sm[k..].iter().cloned().fold(f64::INFINITY, f64::min);
-        low <= sm[k] - 3.0
+        let low = heavy[k..].iter().cloned().fold(f64::INFINITY, f64::min);
+        low <= heavy[k] - 3.0
     });
+    peaks.extend(edge);
     crate::sort::sort_by(&mut peaks, |a, b| {
         b.prominence_db.total_cmp(&a.prominence_db)
     });
     peaks.truncate(options.max_modes);
     crate::sort::sort_by(&mut peaks, |a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     let widths = half_powers(&psd, &peaks, fit_band, (2 * h + 1) as f64 * df, options);
-    let found = unique(&peaks, &widths);
+    let found: Vec<(Peak, HalfPower)> = unique(&peaks, &widths)
+        .into_iter()
+        .filter(|(_, hp)| stands_at_its_width(&psd, hp, [lo, context_hi], h, options))
+        .collect();
     let local = start_peaks(&psd, sweep, band, fit_band, h, options);
     // Rising into the top, or else the highest peak without its 3 dB fall (a mode whose high
     // side the band's end cuts: seeded at its own frequency, a mode if the fit holds it).
-    let rising = rising_into_top(&psd, &sm, lo, h, root, options.min_prominence_db)
+    let rising = rising_into_top(&psd, &heavy, lo, h2, root, options.min_prominence_db)
         .map(|r| Rising {
             seed_hz: 1.05 * fit_band[1],
             ..r
@@ -317,7 +339,7 @@ pub(super) fn sweep_stage(
             Some(Rising {
                 prominence_db: p.prominence_db,
                 top,
-                level: smoothed(&psd, h).psd[top],
+                level: smoothed(&psd, h2).psd[top],
                 seed_hz: p.frequency_hz,
             })
         });
@@ -331,6 +353,32 @@ pub(super) fn sweep_stage(
         local,
         rising,
     }))
+}
+
+/// Whether a peak still stands out (by half `minProminenceDb`, on both sides within `context`)
+/// on the periodogram smoothed over an eighth of its half-power width, where the width is more
+/// than the detection's smoothing: a mode that wide rises over several hertz, while a wiggle
+/// of the periodogram a hertz wide, read with a wide half-power band (a sweep over a band
+/// where the response is flat: 74 Hz, "ζ 0.041", standing 6.2 dB on the √r/8 smoothing), goes
+/// under the heavier smoothing.
+fn stands_at_its_width(
+    psd: &Psd,
+    hp: &HalfPower,
+    context: [usize; 2],
+    h: usize,
+    options: &IdentifyOptions,
+) -> bool {
+    let df = psd.resolution_hz;
+    let hw = ((hp.width_hz / 8.0 / df).round() as usize).min(2000);
+    if hw <= h {
+        return true;
+    }
+    let k = (hp.peak_hz / df).round() as usize;
+    let band = [
+        k.saturating_sub(hw).max(context[0]),
+        (k + hw).min(context[1]),
+    ];
+    !detect_within(psd, band, context, 0.5 * options.min_prominence_db, 1, hw).is_empty()
 }
 
 /// The periodogram in dB on bins `lo..=hi`, averaged over ±`h` bins within them (as the
