@@ -14,7 +14,10 @@
 //!    rectangular window's kernel in the fit); `spectrum` stays the detection PSD. Peaks
 //!    below that band (the sweep's start, where its spectrum is not smooth) narrower than
 //!    √r/4 are fitted each alone on ±3 half-power widths, without the kernel (`local_fits`:
-//!    slow modes rung by the start). Otherwise:
+//!    slow modes rung by the start). At the sweep's end, as at a spectrum file's cliff: a
+//!    response still rising into the band's top, or a peak without a 3 dB fall before it, is
+//!    fitted with a mode seeded past it (never reported) and reported as
+//!    [`Identification::cut_off`] unless the fit holds the mode under the end. Otherwise:
 //! 1. **Peaks.** A Welch PSD (Hann, half overlap, segments of 2^⌊log₂(n/4)⌋ samples by default)
 //!    is smoothed in dB over 7 bins; its local maxima with a topographic prominence of at least
 //!    `minProminenceDb` inside the band are the candidate modes, the most prominent first.

@@ -247,13 +247,13 @@ pub(super) fn welch_stage(
 /// where the excitation's spectrum is not smooth (a linear chirp's spectrum ripples within
 /// about √r of its ends, r the sweep rate in Hz/s; at least 4 bins). The peaks are those of
 /// the periodogram smoothed over about √r/4. A response still rising into the band's top —
-/// the highest bin of the periodogram smoothed over about √r within √r of it, standing `minProminenceDb` over
-/// its left flank (`peaks::rising_into_end`) — is returned as [`Rising`]: a mode at or past
-/// the sweep's end (a 138 Hz mode past Klipper's 133.33 Hz), or one just under it whose fall
-/// is not in the band; so is, when there is no such rise, a peak that does not fall 3 dB
-/// before the band's top (56.8 Hz, ζ 0.06, swept to 62.1 Hz); the joint fit tells which, as
-/// for a spectrum file's cliff. None when
-/// the band is empty or nothing stands out in it (the Welch path then runs).
+/// the highest bin of the periodogram smoothed over about √r within √r of the top, standing
+/// `minProminenceDb` over its left flank (`peaks::rising_into_end`) — is returned as
+/// [`Rising`]: a mode at or past the sweep's end (a 138 Hz mode past Klipper's 133.33 Hz), or
+/// one just under it whose fall is not in the band; so is, when there is no such rise, a peak
+/// that does not fall 3 dB before the band's top (56.8 Hz, ζ 0.06, swept to 62.1 Hz); the
+/// joint fit tells which, as for a spectrum file's cliff. None when the band is empty or
+/// nothing stands out in it (the Welch path then runs).
 pub(super) fn sweep_stage(
     signal: &[f64],
     fs: f64,
