@@ -24,18 +24,7 @@ pub(super) fn detect_within(
     h: usize,
 ) -> Vec<Peak> {
     let [lo, hi] = context;
-    let db: Vec<f64> = psd
-        .psd
-        .iter()
-        .map(|p| 10.0 * p.max(1e-300).log10())
-        .collect();
-    let sm: Vec<f64> = (lo..=hi)
-        .map(|k| {
-            let a = k.saturating_sub(h).max(lo);
-            let b = (k + h).min(hi);
-            db[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
-        })
-        .collect();
+    let sm = smoothed_db(&to_db(&psd.psd), lo, hi, h);
     let n = sm.len();
     let mut peaks = Vec::new();
     for i in 1..n.saturating_sub(1) {
@@ -84,6 +73,22 @@ pub(super) fn detect_within(
     peaks.truncate(max_modes);
     crate::sort::sort_by(&mut peaks, |a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     peaks
+}
+
+/// A PSD in dB (10·log₁₀, floored at 10⁻³⁰⁰).
+pub(super) fn to_db(psd: &[f64]) -> Vec<f64> {
+    psd.iter().map(|p| 10.0 * p.max(1e-300).log10()).collect()
+}
+
+/// `db[lo..=hi]` averaged over ±`h` values within `lo..=hi` (fewer at its ends), indexed from
+/// `lo`: the smoothing peaks are found and measured on.
+pub(super) fn smoothed_db(db: &[f64], lo: usize, hi: usize, h: usize) -> Vec<f64> {
+    (lo..=hi)
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(h).max(lo), (k + h).min(hi));
+            db[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
+        })
+        .collect()
 }
 
 /// A response rising into the end of `sm` (dB, smoothed, one value per bin): its top, the

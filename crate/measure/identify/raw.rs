@@ -5,7 +5,7 @@
 
 use super::decay::{decay_fit, find_decay};
 use super::half_power::{half_power, smoothed, HalfPower};
-use super::peaks::{detect_within, rising_into_end, Peak};
+use super::peaks::{detect_within, rising_into_end, smoothed_db, to_db, Peak};
 use super::sweep::Sweep;
 use super::{FreeDecay, IdentifyOptions, Slot, MAX_MODES};
 use crate::error::{count, positive, Error, Result};
@@ -284,7 +284,7 @@ pub(super) fn sweep_stage(
     // half-power point is fitted), as for a spectrum file's cliff (`spectrum::seeds`); the
     // others are shoulders. A response still rising into the top is `rising`'s.
     let h2 = (4 * h).min(800);
-    let heavy = smoothed_db(&psd, lo, hi, h2);
+    let heavy = smoothed_db(&to_db(&psd.psd), lo, hi, h2);
     let mut peaks = detect_within(
         &psd,
         [lo, hi],
@@ -329,9 +329,11 @@ pub(super) fn sweep_stage(
     // Rising into the top, or else the highest peak without its 3 dB fall (a mode whose high
     // side the band's end cuts: seeded at its own frequency, a mode if the fit holds it).
     let rising = rising_into_top(&psd, &heavy, lo, h2, root, options.min_prominence_db)
-        .map(|r| Rising {
+        .map(|(prominence_db, top)| Rising {
+            prominence_db,
+            top,
+            level: smoothed(&psd, h2).psd[top],
             seed_hz: 1.05 * fit_band[1],
-            ..r
         })
         .or_else(|| {
             let p = shoulders.last()?;
@@ -381,27 +383,11 @@ fn stands_at_its_width(
     !detect_within(psd, band, context, 0.5 * options.min_prominence_db, 1, hw).is_empty()
 }
 
-/// The periodogram in dB on bins `lo..=hi`, averaged over ±`h` bins within them (as the
-/// peaks are found), indexed from `lo`.
-fn smoothed_db(psd: &Psd, lo: usize, hi: usize, h: usize) -> Vec<f64> {
-    let db: Vec<f64> = psd.psd[lo..=hi]
-        .iter()
-        .map(|p| 10.0 * p.max(1e-300).log10())
-        .collect();
-    let n = db.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (i.saturating_sub(h), (i + h).min(n - 1));
-            db[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
-        })
-        .collect()
-}
-
-/// [`Rising`] on `sm`, a sweep's periodogram on bins `lo..` smoothed over ±`h` bins in dB
-/// ([`smoothed_db`]), the top within the last `width_hz` (√r, as the band's margin: the
-/// chirp's spectrum still ripples by a dB or two there, and the smoothed bins scatter as
-/// much: a 72 Hz mode past a 70 Hz end rose 11 dB over the last 10 Hz fitted, its top 0.7 Hz
-/// under the band's end) and at least 2h + 1 bins.
+/// A rise into the top of `sm`, a sweep's periodogram on bins `lo..` smoothed over ±`h` bins
+/// in dB ([`smoothed_db`]): its prominence, dB, and the top's bin, the top within the last
+/// `width_hz` (√r, as the band's margin: the chirp's spectrum still ripples by a dB or two
+/// there, and the smoothed bins scatter as much: a 72 Hz mode past a 70 Hz end rose 11 dB over
+/// the last 10 Hz fitted, its top 0.7 Hz under the band's end) and at least 2h + 1 bins.
 fn rising_into_top(
     psd: &Psd,
     sm: &[f64],
@@ -409,16 +395,9 @@ fn rising_into_top(
     h: usize,
     width_hz: f64,
     min_db: f64,
-) -> Option<Rising> {
+) -> Option<(f64, usize)> {
     let last = ((width_hz / psd.resolution_hz).round() as usize).max(2 * h + 1);
-    let (prominence_db, at) = rising_into_end(sm, last, min_db)?;
-    let top = lo + at;
-    Some(Rising {
-        prominence_db,
-        top,
-        level: smoothed(psd, h).psd[top],
-        seed_hz: f64::NAN,
-    })
+    rising_into_end(sm, last, min_db).map(|(prominence_db, at)| (prominence_db, lo + at))
 }
 
 /// A sweep's whole-record periodogram (rectangular window, linear detrend): what its stage

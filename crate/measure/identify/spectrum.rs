@@ -3,7 +3,7 @@
 
 use super::half_power::{half_power, HalfPower};
 use super::model::WindowSpec;
-use super::peaks::{detect_within, rising_into_end};
+use super::peaks::{detect_within, rising_into_end, smoothed_db};
 use super::{IdentifyOptions, Slot};
 use crate::error::{count, positive, Error, Result};
 use crate::measure::psd::{window, Psd, WindowKind, MAX_SEGMENT_LENGTH};
@@ -278,18 +278,6 @@ fn unnormalized_db(grid: &Grid) -> Vec<f64> {
         .collect()
 }
 
-/// The un-normalised PSD in dB, smoothed over 3 bins within `lo..=hi` (as the peaks are
-/// found: Klipper's bins are coarse), indexed from `lo`.
-fn smoothed_db(grid: &Grid, lo: usize, hi: usize) -> Vec<f64> {
-    let db = unnormalized_db(grid);
-    (lo..=hi)
-        .map(|k| {
-            let (a, b) = (k.saturating_sub(1).max(lo), (k + 1).min(hi));
-            db[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
-        })
-        .collect()
-}
-
 /// A response cut off by the sweep's end: the PSD (un-normalised, 3-bin smoothed) still
 /// rising into the last fitted bins. Its top — the highest of the last three (the window
 /// smears the cliff over ±2 bins, and the sweep's own taper takes a little off them) — stands
@@ -309,5 +297,6 @@ pub(super) fn rising_to_end(
     if cut < lo + 4 {
         return None;
     }
-    rising_into_end(&smoothed_db(grid, lo, cut), 3, min_db).map(|(p, at)| (p, lo + at))
+    rising_into_end(&smoothed_db(&unnormalized_db(grid), lo, cut, 1), 3, min_db)
+        .map(|(p, at)| (p, lo + at))
 }

@@ -219,8 +219,9 @@ mod tests {
             })
             .collect();
         assert!(detect_sweep(&noise, fs).is_none());
-        // The sweep under a steady line ~27 dB over its fundamental (a lightly damped mode rung all through
-        // the test): the strongest bin of every frame is the line, the sweep is still found.
+        // The sweep under a steady line ~27 dB over its fundamental (a lightly damped mode rung
+        // all through the test): the strongest bin of every frame is the line; the sweep is
+        // still found.
         let rung: Vec<f64> = x
             .iter()
             .zip(&tone)
