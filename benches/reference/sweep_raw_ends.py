@@ -12,12 +12,18 @@ raw CSV (`raw_data_x_eNN.csv`) and `manifest.json` ({name, modes: [[f, zeta]], s
 
     python3 benches/reference/sweep_raw_ends.py OUT [N] [SEED]
     python3 benches/reference/sweep_raw_ends.py OUT --flat
+    python3 benches/reference/sweep_raw_ends.py OUT --short [N] [SEED]
     SWEEP_RAW_ENDS_DIR=OUT cargo test --release --test identify_raw_sweep -- --ignored --nocapture
 
 With --flat, four fixed recordings whose swept band holds no mode instead: a mode far past
 the end (250 Hz swept 30-80 Hz, 300 Hz swept 20-120 Hz, 260 Hz swept 5-60 Hz) or far below
 the start (8 Hz swept 30-80 Hz, where the response in the band is flat and only the
 periodogram's wiggles stand out).
+
+With --short, N short recordings instead (1.5-5 s: a fast sweep, as a shaker's chirp or a
+quick test is): 1-3 modes, the first at 25-70 Hz, each next 1.4-1.9 times higher, damping
+ratios log-uniform in 0.015-0.15, peaks 0 to -4 dB, swept from 0.7 times the lowest mode to
+1.3 times the highest (every mode inside the band) at whatever rate fills the drawn duration.
 
 numpy + scipy.
 """
@@ -81,7 +87,42 @@ def flat(out):
         json.dump(manifest, fh, indent=1)
 
 
+def short(out, n, seed):
+    os.makedirs(out, exist_ok=True)
+    rng = np.random.default_rng(seed)
+    manifest = []
+    for i in range(n):
+        k = rng.integers(1, 4)
+        f = [rng.uniform(25, 70)]
+        for _ in range(k - 1):
+            f.append(f[-1] * rng.uniform(1.4, 1.9))
+        modes = [(fi, float(np.exp(rng.uniform(np.log(0.015), np.log(0.15)))),
+                  float(rng.uniform(-4, 0))) for fi in f]
+        start, end = 0.7 * f[0], 1.3 * f[-1]
+        duration = float(rng.uniform(1.5, 5.0))
+        name = "s%02d" % i
+        case = dict(name=name, axis="x", rate=3200.0, seed=9000 + i + 100 * seed,
+                    noise=float(rng.uniform(150, 400)),
+                    modes=[st.mode(a, b, c) for a, b, c in modes],
+                    excitation=st.exc(start, end, hps=(end - start) / duration),
+                    outputs=["raw"], note="")
+        st.normalize_gains(case["modes"])
+        case.setdefault("drift", dict(st.DRIFT))
+        st.write_files(case, out)
+        manifest.append(dict(name=name, modes=[[m["f"], m["zeta"]] for m in case["modes"]],
+                             start=start, end=end))
+        print(name, "%.1f-%.1f Hz in %.1f s" % (start, end, duration),
+              ", ".join("%.1f Hz zeta %.3f" % (m["f"], m["zeta"]) for m in case["modes"]))
+    with open(os.path.join(out, "manifest.json"), "w") as fh:
+        json.dump(manifest, fh, indent=1)
+
+
 if __name__ == "__main__":
+    if "--short" in sys.argv[1:]:
+        a = [x for x in sys.argv[1:] if x != "--short"]
+        short(a[0] if a else "/tmp/raw_short", int(a[1]) if len(a) > 1 else 16,
+              int(a[2]) if len(a) > 2 else 1)
+        sys.exit(0)
     if "--flat" in sys.argv[1:]:
         flat(next((a for a in sys.argv[1:] if a != "--flat"), "/tmp/raw_flat"))
         sys.exit(0)

@@ -9,13 +9,14 @@
 //! sees at any moment is dominated by the response at the current drive frequency f(t).
 //!
 //! The sweep is read from the data itself, not from the test's parameters: short Hann frames
-//! (about 1 s, a quarter-frame hop), the bin of each that stands highest over its own mean log
+//! (about 1 s, a quarter-frame hop; shorter, down to 1/16 s, for a record under 4 s or a sweep
+//! they do not find: a fast one), the bin of each that stands highest over its own usual log
 //! power through the record (above the second bin, where the slow component and drift sit;
-//! a mode rung all through the test is the strongest bin but no sweep), interpolated in log
-//! power, and a straight line f(t) = f₀ + r·t
-//! fitted robustly (Theil–Sen slope, then least squares over the frames within two bins of it).
-//! A recording is a sweep when the line holds for most frames and spans at least eight frame
-//! bins. Its band is the line over the inlying frames, widened by half a frame's worth of sweep
+//! a mode rung all through the test is the strongest bin but no sweep; a harmonic of the
+//! drive gives way to the fundamental under it), interpolated in log power, and a straight
+//! line f(t) = f₀ + r·t fitted robustly (Theil–Sen slope, then least squares over the frames
+//! within two bins of it). A recording is a sweep when the line holds for most frames and
+//! spans at least eight frame bins (four of the shorter frames' wider bins). Its band is the line over the inlying frames, widened by half a frame's worth of sweep
 //! at each end (a frame's ridge is the mean frequency over the frame).
 //!
 //! Why it matters: a Welch average of a sweep with segments shorter than the record is lumpy
@@ -65,30 +66,47 @@ fn frames(signal: &[f64], fs: f64, len: usize, mut each: impl FnMut(f64, &[f64],
 }
 
 /// The ridge of each frame: (frame centre s, frequency Hz), frames with power. The ridge is
-/// the bin standing highest over its own level through the record (the mean of its log power
-/// over all frames), not the strongest bin: a lightly damped mode rung all through the test
-/// (by the slow sweep's steps, the drive's harmonics, the start) is the strongest bin of most
-/// frames where the drive is far from it — a 59.75 Hz, ζ 0.02 mode swept 40–60 Hz at 2 Hz/s,
-/// or a 140 Hz mode past a 133 Hz end, hid the sweep — while the drive passes each bin in a
-/// few frames and stands there tens of dB over the bin's usual level. Steady lines (a mode's
-/// ringing, the slow sweep's harmonics, mains hum) are level with their own mean and drop out.
+/// the bin standing highest over its own usual level through the record, not the strongest
+/// bin: a lightly damped mode rung all through the test (by the slow sweep's steps, the
+/// drive's harmonics, the start) is the strongest bin of most frames where the drive is far
+/// from it — a 59.75 Hz, ζ 0.02 mode swept 40–60 Hz at 2 Hz/s, or a 140 Hz mode past a 133 Hz
+/// end, hid the sweep — while the drive passes each bin in a few frames and stands there tens
+/// of dB over the bin's usual level. Steady lines (a mode's ringing, the slow sweep's
+/// harmonics, mains hum) are level with their own usual level and drop out. The usual level is
+/// the lower quintile of the bin's log power over the frames (at most `MAX_LEVEL_FRAMES`,
+/// evenly spread), not its mean: in a narrow sweep the drive (with its main lobe's ±2 bins)
+/// is near each bin for much of the record and raised the mean to its own level (23–32.6 Hz
+/// at 2 Hz/s, 0.64 s frames: two thirds of the time), and the third harmonic stood higher.
+/// A bin at a fraction of the top's frequency may still be the fundamental (`fundamental`).
 /// The peak is then interpolated in log power on the frame's own spectrum.
 fn ridge(signal: &[f64], fs: f64, len: usize) -> Vec<(f64, f64)> {
-    let mut level = vec![0.0; len / 2];
-    let mut count = 0usize;
+    let half = len / 2;
+    let count = (signal.len().saturating_sub(len) / (len / 4).max(1) + 1).max(1);
+    let stride = count.div_ceil(MAX_LEVEL_FRAMES);
+    let mut logs: Vec<f32> = Vec::new();
+    let mut i = 0usize;
     frames(signal, fs, len, |_, p, _| {
-        for (l, v) in level.iter_mut().zip(p) {
-            *l += v.max(1e-300).ln();
+        if i.is_multiple_of(stride) {
+            logs.extend(p.iter().map(|v| v.max(1e-300).ln() as f32));
         }
-        count += 1;
+        i += 1;
     });
-    for l in &mut level {
-        *l /= count.max(1) as f64;
-    }
+    let kept = logs.len() / half.max(1);
+    let mut column = vec![0f32; kept];
+    let level: Vec<f64> = (0..half)
+        .map(|k| {
+            for (c, j) in column.iter_mut().zip(0..kept) {
+                *c = logs[j * half + k];
+            }
+            column.sort_by(f32::total_cmp);
+            column.get(kept / 5).map_or(0.0, |&v| f64::from(v))
+        })
+        .collect();
     let mut out = Vec::new();
     frames(signal, fs, len, |centre, p, total| {
         let lift = |k: usize| p[k].max(1e-300).ln() - level[k];
-        if let Some(k) = (3..len / 2 - 1).max_by(|&a, &b| lift(a).total_cmp(&lift(b))) {
+        if let Some(top) = (3..len / 2 - 1).max_by(|&a, &b| lift(a).total_cmp(&lift(b))) {
+            let k = fundamental(p, top, &lift);
             let (ym, y0, yp) = (
                 p[k - 1].max(1e-300).ln(),
                 p[k].max(1e-300).ln(),
@@ -113,6 +131,32 @@ fn ridge(signal: &[f64], fs: f64, len: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// The most frames a bin's usual level is read from (evenly spread over the record): 256
+/// frames of 2048 bins keep 2 MB.
+const MAX_LEVEL_FRAMES: usize = 256;
+
+/// The drive's fundamental for a frame whose highest-standing bin is `top`: the bin nearest
+/// `top`/d (d = 5, 4, 3, 2, the lowest first; ±1 bin) that holds more power than `top` and
+/// stands at least half as high over its usual level, else `top`. A square-wave drive's third
+/// harmonic carries a ninth of the fundamental's power but can stand higher over its bins'
+/// level, spread over three times as many bins as the fundamental dwells in.
+fn fundamental(p: &[f64], top: usize, lift: &impl Fn(usize) -> f64) -> usize {
+    let raise = lift(top);
+    for d in (2..=5).rev() {
+        let c = (top as f64 / d as f64).round() as usize;
+        if c < 4 || c + 1 >= p.len() {
+            continue;
+        }
+        let j = (c - 1..=c + 1)
+            .max_by(|&a, &b| p[a].total_cmp(&p[b]))
+            .unwrap_or(c);
+        if p[j] > p[top] && lift(j) >= 0.5 * raise {
+            return j;
+        }
+    }
+    top
+}
+
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -132,12 +176,37 @@ fn line(points: &[(f64, f64)]) -> Option<(f64, f64)> {
 }
 
 /// Finds a linear sweep in `signal` sampled at `fs` (see the module docs); None when the
-/// excitation is not one (noise, a hit, a record shorter than 8 frames).
+/// excitation is not one (noise, a hit, a record shorter than 4 frames of 1/16 s).
+///
+/// Frames of about a second first; a record shorter than 4 such frames (13 at the quarter
+/// hop), or one where they find no sweep, is read again with frames half as long, down to
+/// 1/16 s while the record holds 4 of them. A fast sweep is only seen that
+/// way: 20–120 Hz in 2 s passes 50 Hz within a one-second frame, whose ridge is then the
+/// mean of a smear, and a record of 2 s has too few such frames for a line. Shorter frames
+/// have wider bins (16 Hz at 1/16 s), which a fast sweep's span of dozens of bins allows; a
+/// line through them must span 4 of them (8 of the first frames' bins): 15 Hz swept in
+/// 1.7 s spans 4.9 bins of the 0.32 s frames that record holds 18 of.
 pub(super) fn detect_sweep(signal: &[f64], fs: f64) -> Option<Sweep> {
-    let len = (fs.round() as usize).next_power_of_two().clamp(64, 1 << 16);
-    if signal.len() < 4 * len {
-        return None;
+    let first = (fs.round() as usize).next_power_of_two().clamp(64, 1 << 16);
+    let last = ((fs / 16.0).round() as usize).next_power_of_two().max(64);
+    let mut len = first;
+    loop {
+        if signal.len() >= 4 * len {
+            let span_bins = if len == first { 8.0 } else { 4.0 };
+            if let Some(s) = sweep_with_frames(signal, fs, len, span_bins) {
+                return Some(s);
+            }
+        }
+        if len / 2 < last {
+            return None;
+        }
+        len /= 2;
     }
+}
+
+/// The sweep as frames of `len` samples see it, spanning at least `span_bins` of their bins
+/// (see `detect_sweep`).
+fn sweep_with_frames(signal: &[f64], fs: f64, len: usize, span_bins: f64) -> Option<Sweep> {
     let frames = ridge(signal, fs, len);
     let n = frames.len();
     if n < 8 {
@@ -171,7 +240,7 @@ pub(super) fn detect_sweep(signal: &[f64], fs: f64) -> Option<Sweep> {
     let half = 0.5 * len as f64 / fs * r.abs();
     let (fa, fb) = (b + r * t0, b + r * t1);
     let band = [fa.min(fb) - half, fa.max(fb) + half];
-    if band[1] - band[0] < 8.0 * bin || band[0] <= 0.0 {
+    if band[1] - band[0] < span_bins * bin || band[0] <= 0.0 {
         return None;
     }
     Some(Sweep {
@@ -230,5 +299,53 @@ mod tests {
         let s = detect_sweep(&rung, fs).unwrap();
         assert!((s.rate_hz_per_s - r).abs() < 0.05 * r, "{s:?}");
         assert!((s.band_hz[1] - (f0 + r * dur)).abs() < 2.0, "{s:?}");
+    }
+
+    /// Klipper's drive as a square wave of amplitude ∝ f whose frequency rises from `f0` at
+    /// `r` Hz/s for `dur` s, sampled at `fs`.
+    fn square_sweep(f0: f64, r: f64, dur: f64, fs: f64) -> Vec<f64> {
+        (0..(dur * fs) as usize)
+            .map(|i| {
+                let t = i as f64 / fs;
+                let f = f0 + r * t;
+                f * (2.0 * std::f64::consts::PI * (f0 * t + 0.5 * r * t * t))
+                    .sin()
+                    .signum()
+            })
+            .collect()
+    }
+
+    /// Short records: 20 → 120 Hz in 2 s (a fast sweep: frames of a second would each smear
+    /// 50 Hz, and the record holds fewer than four of them) and 23 → 32.6 Hz at 2 Hz/s in
+    /// 4.8 s (a narrow sweep whose fundamental dwells in each of the 0.64 s frames' bins for
+    /// a sixth of the record: the mean level of those bins is the drive's own, and the third
+    /// harmonic, spread over three times the bins, stood higher over its mean: the ridge
+    /// jumped to 77–88 Hz in mid-record). Two seconds of noise or of a tone are no sweep.
+    #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
+    fn finds_short_fast_and_short_narrow_sweeps() {
+        let fs = 3200.0;
+        let s = detect_sweep(&square_sweep(20.0, 50.0, 2.0, fs), fs).unwrap();
+        assert!((s.rate_hz_per_s - 50.0).abs() < 0.05 * 50.0, "{s:?}");
+        assert!((s.band_hz[0] - 20.0).abs() < 4.0, "{s:?}");
+        assert!((s.band_hz[1] - 120.0).abs() < 4.0, "{s:?}");
+        let s = detect_sweep(&square_sweep(23.0, 2.0, 4.8, fs), fs).unwrap();
+        assert!((s.rate_hz_per_s - 2.0).abs() < 0.1 * 2.0, "{s:?}");
+        assert!((s.band_hz[0] - 23.0).abs() < 1.5, "{s:?}");
+        assert!((s.band_hz[1] - 32.6).abs() < 1.5, "{s:?}");
+        let n = (2.0 * fs) as usize;
+        let tone: Vec<f64> = (0..n)
+            .map(|i| (2.0 * std::f64::consts::PI * 37.0 * i as f64 / fs).sin())
+            .collect();
+        assert!(detect_sweep(&tone, fs).is_none());
+        let mut state = 777u64;
+        let noise: Vec<f64> = (0..n)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect();
+        assert!(detect_sweep(&noise, fs).is_none());
     }
 }
