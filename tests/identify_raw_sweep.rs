@@ -219,6 +219,25 @@ fn short_fast_sweeps_are_found_and_their_modes_right() {
     }
 }
 
+/// A sweep over a band that holds no mode (one mode at 8 Hz, swept 30–80 Hz at 2 Hz/s):
+/// the sweep is reported, no mode, and a note says why. Before, a sweep whose band showed no
+/// peak was dropped and the recording went the Welch path, which is not for sweeps, and
+/// said nothing.
+#[test]
+fn a_sweep_over_a_band_without_modes_is_reported_with_a_note() {
+    let fs = 1600.0;
+    for seed in [41, 42] {
+        let modes = [sim(8.0, 0.05, 0.0)];
+        let id = identified(&record(&modes, 30.0, 80.0, 2.0, fs, 200.0, seed), fs);
+        let sweep = id.sweep.expect("the sweep is reported");
+        assert!((sweep.band_hz[0] - 30.0).abs() < 1.0, "{sweep:?}");
+        assert!((sweep.band_hz[1] - 80.0).abs() < 1.0, "{sweep:?}");
+        assert!(id.modes.is_empty(), "{:?}", id.modes);
+        assert_eq!(id.notes.len(), 1, "{:?}", id.notes);
+        assert!(id.notes[0].contains("no mode stands out"), "{:?}", id.notes);
+    }
+}
+
 /// Random raw sweeps ending around their highest mode, written by
 /// benches/reference/sweep_raw_ends.py (`SWEEP_RAW_ENDS_DIR`; docs/measured-data.md). Counts
 /// the modes whose high half-power point lies under the sweep's end less √r (inside the

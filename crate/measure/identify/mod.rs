@@ -451,7 +451,7 @@ pub struct Identification {
     /// but reported so that such a file does not come out as "no mode". `None` otherwise.
     pub cut_off: Option<CutOff>,
     /// What the identification could not do, in words for the user (a response cut off by
-    /// the sweep's end). Empty when none.
+    /// the sweep's end; a raw recording's sweep whose band shows no peak). Empty when none.
     pub notes: Vec<String>,
 }
 
@@ -493,7 +493,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         notes: Vec::new(),
     };
     // A sweep (unless the segments are given): its whole-record periodogram inside its band;
-    // otherwise (or when nothing is found there) the Welch path.
+    // otherwise the Welch path.
     let sweep = options
         .segment_length
         .is_none()
@@ -503,8 +503,17 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         Some(s) => raw::sweep_stage(signal, fs, s, band, options)?,
         None => None,
     };
-    if stage.is_some() {
+    if let Some(s) = sweep {
+        // A sweep's band with no peak: no mode to read there, and the Welch path, not meant
+        // for sweeps, would read its lumps as modes.
         result.sweep = sweep;
+        if stage.is_none() {
+            result.notes.push(format!(
+                "A sweep was found ({:.1}–{:.1} Hz at {:.2} Hz/s) but no mode stands out in                  the band fitted inside it: the response there is flat, or the band is too                  narrow for this sweep rate.",
+                s.band_hz[0], s.band_hz[1], s.rate_hz_per_s
+            ));
+            return Ok(result);
+        }
     } else {
         stage = raw::welch_stage(signal, psd0, n0, band, options)?;
     }

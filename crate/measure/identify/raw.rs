@@ -253,7 +253,7 @@ pub(super) fn welch_stage(
 /// one just under it whose fall is not in the band; so is, when there is no such rise, a peak
 /// that does not fall 3 dB before the band's top (56.8 Hz, ζ 0.06, swept to 62.1 Hz); the
 /// joint fit tells which, as for a spectrum file's cliff. None when the band is empty or
-/// nothing stands out in it (the Welch path then runs).
+/// nothing stands out in it (`identify` then reports the sweep, no mode and a note).
 pub(super) fn sweep_stage(
     signal: &[f64],
     fs: f64,
