@@ -291,7 +291,13 @@ fn raw_sweep_ends() {
                             .total_cmp(&(b.frequency_hz - f).abs())
                     })
                     .map_or("none".into(), |m| {
-                        format!("{:.2}/{:.4}", m.frequency_hz, m.damping)
+                        format!(
+                            "{:.2} ± {:.2} / {:.4} ± {:.4}",
+                            m.frequency_hz,
+                            m.frequency_uncertainty_hz,
+                            m.damping,
+                            m.damping_uncertainty
+                        )
                     });
                 line.push(format!(
                     "{f:.1}/{z:.3} inside {}",
