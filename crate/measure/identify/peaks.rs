@@ -26,6 +26,7 @@ pub(super) fn detect_within(
     let [lo, hi] = context;
     let sm = smoothed_db(&to_db(&psd.psd), lo, hi, h);
     let n = sm.len();
+    let (lefts, rights) = bases(&sm);
     let mut peaks = Vec::new();
     for i in 1..n.saturating_sub(1) {
         if lo + i < band[0] || lo + i > band[1] {
@@ -34,25 +35,7 @@ pub(super) fn detect_within(
         if !(sm[i] > sm[i - 1] && sm[i] >= sm[i + 1]) {
             continue;
         }
-        let mut left = sm[i];
-        let mut j = i;
-        while j > 0 {
-            j -= 1;
-            if sm[j] > sm[i] {
-                break;
-            }
-            left = left.min(sm[j]);
-        }
-        let mut right = sm[i];
-        let mut j = i;
-        while j + 1 < n {
-            j += 1;
-            if sm[j] > sm[i] {
-                break;
-            }
-            right = right.min(sm[j]);
-        }
-        let prominence = sm[i] - left.max(right);
+        let prominence = sm[i] - lefts[i].max(rights[i]);
         if prominence >= min_db {
             // The raw maximum near the smoothed one.
             let k0 = lo + i;
@@ -75,18 +58,57 @@ pub(super) fn detect_within(
     peaks
 }
 
+/// Each value's bases: the lowest value between it and the nearest higher one on its left
+/// (the start when none; the value itself included, the higher one not), and the same on its
+/// right. One pass each way with a stack of the values not yet exceeded, each holding the
+/// lowest value of the run it closes: O(n), where walking out from every maximum is O(n²) on
+/// a long sweep's periodogram (tens of thousands of bins, thousands of maxima).
+fn bases(sm: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    fn pass(values: impl Iterator<Item = f64>, n: usize) -> Vec<f64> {
+        let mut stack: Vec<(f64, f64)> = Vec::new();
+        let mut out = Vec::with_capacity(n);
+        for v in values {
+            let mut low = v;
+            while let Some(&(top, run_low)) = stack.last() {
+                if top > v {
+                    break;
+                }
+                low = low.min(run_low);
+                stack.pop();
+            }
+            out.push(low);
+            stack.push((v, low));
+        }
+        out
+    }
+    let n = sm.len();
+    let left = pass(sm.iter().copied(), n);
+    let mut right = pass(sm.iter().rev().copied(), n);
+    right.reverse();
+    (left, right)
+}
+
 /// A PSD in dB (10·log₁₀, floored at 10⁻³⁰⁰).
 pub(super) fn to_db(psd: &[f64]) -> Vec<f64> {
     psd.iter().map(|p| 10.0 * p.max(1e-300).log10()).collect()
 }
 
 /// `db[lo..=hi]` averaged over ±`h` values within `lo..=hi` (fewer at its ends), indexed from
-/// `lo`: the smoothing peaks are found and measured on.
+/// `lo`: the smoothing peaks are found and measured on. By running sums (a long sweep's
+/// periodogram has tens of thousands of bins in its band and `h` reaches hundreds: summing
+/// each window anew was most of a 128 s recording's identification).
 pub(super) fn smoothed_db(db: &[f64], lo: usize, hi: usize, h: usize) -> Vec<f64> {
+    let mut prefix = Vec::with_capacity(hi + 2 - lo);
+    prefix.push(0.0);
+    let mut total = 0.0;
+    for v in &db[lo..=hi] {
+        total += v;
+        prefix.push(total);
+    }
     (lo..=hi)
         .map(|k| {
             let (a, b) = (k.saturating_sub(h).max(lo), (k + h).min(hi));
-            db[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
+            (prefix[b + 1 - lo] - prefix[a - lo]) / (b - a + 1) as f64
         })
         .collect()
 }
@@ -122,7 +144,41 @@ pub(super) fn rising_into_end(sm: &[f64], last: usize, min_db: f64) -> Option<(f
 
 #[cfg(test)]
 mod tests {
-    use super::rising_into_end;
+    use super::{bases, rising_into_end};
+
+    /// The stack's bases are the walk's: from each value out to the first higher one on each
+    /// side, the lowest value met (itself included). Random sequences with many ties (values
+    /// on a coarse grid) and a long one.
+    #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
+    fn bases_are_the_walks_lowest_values() {
+        let walk = |sm: &[f64], i: usize, step: isize| {
+            let mut low = sm[i];
+            let mut j = i as isize + step;
+            while j >= 0 && (j as usize) < sm.len() && sm[j as usize] <= sm[i] {
+                low = low.min(sm[j as usize]);
+                j += step;
+            }
+            low
+        };
+        let mut state = 99u64;
+        for n in [1usize, 2, 3, 10, 57, 400, 3000] {
+            for levels in [3u64, 50, 1 << 20] {
+                let sm: Vec<f64> = (0..n)
+                    .map(|_| {
+                        state = state
+                            .wrapping_mul(6364136223846793005)
+                            .wrapping_add(1442695040888963407);
+                        ((state >> 33) % levels) as f64 - 7.5
+                    })
+                    .collect();
+                let (left, right) = bases(&sm);
+                for i in 0..n {
+                    assert_eq!(left[i], walk(&sm, i, -1), "n {n} left {i}");
+                    assert_eq!(right[i], walk(&sm, i, 1), "n {n} right {i}");
+                }
+            }
+        }
+    }
 
     /// A ramp into the end stands its rise; a peak inside with a higher bin on its left is
     /// measured down to the lowest point after that bin; a falling end is no candidate.
