@@ -13,14 +13,10 @@
 // alternate, file by file, so a machine whose load moves treats them alike. Per file and
 // module: the median and range of RUNS timed calls after 2 warm-ups, wall time in the worker
 // (performance.now()), each call its own message as the page sends them.
-import { chromium } from 'playwright-core';
 import { readFileSync } from 'node:fs';
-import { execFileSync } from 'node:child_process';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { startServer } from '../scripts/serve.mjs';
+import { header, root, uptime, withWorkers } from './worker_bench.mjs';
 
-const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const list = (v, d) => (v ? v.split(',').filter(Boolean) : d);
 const FILES = list(process.env.FILES, [
   'resonances_x_m1.csv', 'resonances_y_three.csv', 'resonances_y_two38x14.csv', 'resonances_x_cliff133.csv',
@@ -67,30 +63,10 @@ onmessage = async ({ data }) => {
   postMessage({ times, modes, pick: rank.klipper?.best ?? rank.recommended });
 };`;
 
-const uptime = () => execFileSync('uptime', { encoding: 'utf8' }).trim();
-const load0 = uptime();
-const commit = execFileSync('git', ['rev-parse', '--short', 'HEAD'], { cwd: root, encoding: 'utf8' }).trim();
-console.log(`${new Date().toISOString()} commit ${commit}; ${load0}`);
-
-const { server, url } = await startServer({ port: 0 });
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  args: ['--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-});
+const load0 = header();
 const median = (v) => [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)];
 const range = (v) => `${Math.min(...v).toFixed(0)}–${Math.max(...v).toFixed(0)}`;
-try {
-  const page = await browser.newPage();
-  await page.goto(`${url}/benches/blank`);
-  await page.evaluate(async ([source, urls]) => {
-    const blob = URL.createObjectURL(new Blob([source], { type: 'text/javascript' }));
-    window.__workers = await Promise.all(urls.map((u) => new Promise((done, fail) => {
-      const w = new Worker(blob, { type: 'module' });
-      w.onerror = (e) => fail(new Error(e.message));
-      w.onmessage = () => done(w);
-      w.postMessage({ type: 'init', url: new URL(u, location.href).href });
-    })));
-  }, [WORKER, MODULES.map((m) => `/${m}`)]);
+await withWorkers(WORKER, MODULES, async (page) => {
   for (const file of FILES) {
     const results = MODULES.map(() => ({ identify: [], klipper: [], total: [], modes: '', pick: '' }));
     for (let i = 0; i < RUNS; i++) {
@@ -112,8 +88,5 @@ try {
         + `(${range(r.total)}), ${r.total.length} runs; modes ${r.modes}`);
     });
   }
-} finally {
-  await browser.close();
-  server.close();
-}
+});
 console.log(`machine: ${load0.replace(/.*load/, 'load')} at the start, ${uptime().replace(/.*load/, 'load')} at the end`);

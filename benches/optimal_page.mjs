@@ -17,14 +17,11 @@
 // one axis's optimal recommendation, wall time in the worker (performance.now()), each call
 // its own message as the page sends them. NUMPY_RUNS=0
 // skips the numpy side (its fit takes seconds per file).
-import { chromium } from 'playwright-core';
 import { readFileSync } from 'node:fs';
 import { execFileSync } from 'node:child_process';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { startServer } from '../scripts/serve.mjs';
+import { header, root, uptime, withWorkers } from './worker_bench.mjs';
 
-const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const list = (v, d) => (v ? v.split(',').filter(Boolean) : d);
 const FILES = list(process.env.FILES, [
   'resonances_x_m1.csv', 'resonances_y_m1.csv', 'resonances_y_three.csv', 'resonances_y_z020f61.csv',
@@ -73,32 +70,9 @@ onmessage = async ({ data }) => {
   postMessage({ times, label: best.label, score: best.klipperScore, vibrations: best.remainingVibration });
 };`;
 
-const uptime = () => execFileSync('uptime', { encoding: 'utf8' }).trim();
-const load0 = uptime();
-const commit = execFileSync('git', ['rev-parse', '--short', 'HEAD'], { cwd: root, encoding: 'utf8' }).trim();
-console.log(`${new Date().toISOString()} commit ${commit}; ${load0}`);
-
-const { server, url } = await startServer({ port: 0 });
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  args: ['--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-});
+const load0 = header();
 const results = new Map(); // `${file} ${firmware} ${module}` → times
-try {
-  const page = await browser.newPage();
-  // A document of the server's origin (its 404 page) without the page's own work: the workers
-  // are all that runs.
-  await page.goto(`${url}/benches/blank`);
-  // One worker per module, as the page keeps one measured-data worker.
-  await page.evaluate(async ([source, urls]) => {
-    const blob = URL.createObjectURL(new Blob([source], { type: 'text/javascript' }));
-    window.__workers = await Promise.all(urls.map((u) => new Promise((done, fail) => {
-      const w = new Worker(blob, { type: 'module' });
-      w.onerror = (e) => fail(new Error(e.message));
-      w.onmessage = () => done(w);
-      w.postMessage({ type: 'init', url: new URL(u, location.href).href });
-    })));
-  }, [WORKER, MODULES.map((m) => `/${m}`)]);
+await withWorkers(WORKER, MODULES, async (page) => {
   for (const file of FILES) {
     const spectrum = read(file);
     for (const firmware of FIRMWARES) {
@@ -129,8 +103,5 @@ try {
       console.log(`${py.replace(/^[^:]*: /, `${file} numpy (klipper_reference.py, Klipper's fit): `)}`);
     }
   }
-} finally {
-  await browser.close();
-  server.close();
-}
+});
 console.log(`machine: ${load0.replace(/.*load/, 'load')} at the start, ${uptime().replace(/.*load/, 'load')} at the end`);

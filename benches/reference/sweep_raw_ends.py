@@ -37,33 +37,49 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sweep_testset as st  # noqa: E402
 
 
+def draw_modes(rng, kmax, f_lo, zeta_hi):
+    """1 to kmax modes: the first at f_lo-70 Hz, each next 1.4-1.9 times higher, damping
+    ratios log-uniform in 0.015-zeta_hi, peaks 0 to -4 dB: [(f, zeta, rel_db)]."""
+    k = rng.integers(1, kmax + 1)
+    f = [rng.uniform(f_lo, 70)]
+    for _ in range(k - 1):
+        f.append(f[-1] * rng.uniform(1.4, 1.9))
+    return [(fi, float(np.exp(rng.uniform(np.log(0.015), np.log(zeta_hi)))),
+             float(rng.uniform(-4, 0))) for fi in f]
+
+
+def write_case(out, manifest, name, seed, noise, modes, start, end, hps):
+    """One raw recording (sweep_testset.py's model) and its manifest entry."""
+    case = dict(name=name, axis="x", rate=3200.0, seed=seed, noise=noise,
+                modes=[st.mode(a, b, c) for a, b, c in modes],
+                excitation=st.exc(start, end, hps=hps), outputs=["raw"], note="")
+    st.normalize_gains(case["modes"])
+    case.setdefault("drift", dict(st.DRIFT))
+    st.write_files(case, out)
+    manifest.append(dict(name=name, modes=[[m["f"], m["zeta"]] for m in case["modes"]],
+                         start=start, end=end))
+    return case
+
+
+def write_manifest(out, manifest):
+    with open(os.path.join(out, "manifest.json"), "w") as fh:
+        json.dump(manifest, fh, indent=1)
+
+
 def main(out, n, seed):
     os.makedirs(out, exist_ok=True)
     rng = np.random.default_rng(seed)
     manifest = []
     for i in range(n):
-        k = rng.integers(1, 3)
-        f = [rng.uniform(30, 70)]
-        for _ in range(k - 1):
-            f.append(f[-1] * rng.uniform(1.4, 1.9))
-        modes = [(fi, float(np.exp(rng.uniform(np.log(0.015), np.log(0.12)))),
-                  float(rng.uniform(-4, 0))) for fi in f]
-        start = 0.7 * f[0]
-        end = f[-1] * rng.uniform(0.9, 1.25)
+        modes = draw_modes(rng, 2, 30, 0.12)
+        start = 0.7 * modes[0][0]
+        end = modes[-1][0] * rng.uniform(0.9, 1.25)
         name = "e%02d" % i
-        case = dict(name=name, axis="x", rate=3200.0, seed=5000 + i + 100 * seed,
-                    noise=float(rng.uniform(150, 400)),
-                    modes=[st.mode(a, b, c) for a, b, c in modes],
-                    excitation=st.exc(start, end, hps=2.0), outputs=["raw"], note="")
-        st.normalize_gains(case["modes"])
-        case.setdefault("drift", dict(st.DRIFT))
-        st.write_files(case, out)
-        manifest.append(dict(name=name, modes=[[m["f"], m["zeta"]] for m in case["modes"]],
-                             start=start, end=end))
+        case = write_case(out, manifest, name, 5000 + i + 100 * seed,
+                          float(rng.uniform(150, 400)), modes, start, end, 2.0)
         print(name, "%.1f-%.1f Hz" % (start, end),
               ", ".join("%.1f Hz zeta %.3f" % (m["f"], m["zeta"]) for m in case["modes"]))
-    with open(os.path.join(out, "manifest.json"), "w") as fh:
-        json.dump(manifest, fh, indent=1)
+    write_manifest(out, manifest)
 
 
 FLAT = [([(250.0, 0.05, 0.0)], 30.0, 80.0), ([(300.0, 0.03, 0.0)], 20.0, 120.0),
@@ -74,17 +90,8 @@ def flat(out):
     os.makedirs(out, exist_ok=True)
     manifest = []
     for i, (modes, start, end) in enumerate(FLAT):
-        name = "e%02d" % i
-        case = dict(name=name, axis="x", rate=3200.0, seed=700 + i, noise=200.0,
-                    modes=[st.mode(*m) for m in modes], excitation=st.exc(start, end, hps=2.0),
-                    outputs=["raw"], note="")
-        st.normalize_gains(case["modes"])
-        case.setdefault("drift", dict(st.DRIFT))
-        st.write_files(case, out)
-        manifest.append(dict(name=name, modes=[[m["f"], m["zeta"]] for m in case["modes"]],
-                             start=start, end=end))
-    with open(os.path.join(out, "manifest.json"), "w") as fh:
-        json.dump(manifest, fh, indent=1)
+        write_case(out, manifest, "e%02d" % i, 700 + i, 200.0, modes, start, end, 2.0)
+    write_manifest(out, manifest)
 
 
 def short(out, n, seed):
@@ -92,29 +99,16 @@ def short(out, n, seed):
     rng = np.random.default_rng(seed)
     manifest = []
     for i in range(n):
-        k = rng.integers(1, 4)
-        f = [rng.uniform(25, 70)]
-        for _ in range(k - 1):
-            f.append(f[-1] * rng.uniform(1.4, 1.9))
-        modes = [(fi, float(np.exp(rng.uniform(np.log(0.015), np.log(0.15)))),
-                  float(rng.uniform(-4, 0))) for fi in f]
-        start, end = 0.7 * f[0], 1.3 * f[-1]
+        modes = draw_modes(rng, 3, 25, 0.15)
+        start, end = 0.7 * modes[0][0], 1.3 * modes[-1][0]
         duration = float(rng.uniform(1.5, 5.0))
         name = "s%02d" % i
-        case = dict(name=name, axis="x", rate=3200.0, seed=9000 + i + 100 * seed,
-                    noise=float(rng.uniform(150, 400)),
-                    modes=[st.mode(a, b, c) for a, b, c in modes],
-                    excitation=st.exc(start, end, hps=(end - start) / duration),
-                    outputs=["raw"], note="")
-        st.normalize_gains(case["modes"])
-        case.setdefault("drift", dict(st.DRIFT))
-        st.write_files(case, out)
-        manifest.append(dict(name=name, modes=[[m["f"], m["zeta"]] for m in case["modes"]],
-                             start=start, end=end))
+        case = write_case(out, manifest, name, 9000 + i + 100 * seed,
+                          float(rng.uniform(150, 400)), modes, start, end,
+                          (end - start) / duration)
         print(name, "%.1f-%.1f Hz in %.1f s" % (start, end, duration),
               ", ".join("%.1f Hz zeta %.3f" % (m["f"], m["zeta"]) for m in case["modes"]))
-    with open(os.path.join(out, "manifest.json"), "w") as fh:
-        json.dump(manifest, fh, indent=1)
+    write_manifest(out, manifest)
 
 
 if __name__ == "__main__":

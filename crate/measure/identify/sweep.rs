@@ -259,35 +259,15 @@ mod tests {
     fn finds_a_linear_sweep_and_nothing_else() {
         let fs = 2000.0;
         let (f0, r, dur) = (20.0, 4.0, 15.0);
-        let n = (dur * fs) as usize;
-        let x: Vec<f64> = (0..n)
-            .map(|i| {
-                let t = i as f64 / fs;
-                let phase = f0 * t + 0.5 * r * t * t;
-                let f = f0 + r * t;
-                f * (2.0 * std::f64::consts::PI * phase).sin().signum()
-            })
-            .collect();
+        let x = square_sweep(f0, r, dur, fs);
         let s = detect_sweep(&x, fs).unwrap();
         assert!((s.rate_hz_per_s - r).abs() < 0.05 * r, "{s:?}");
         assert!((s.band_hz[0] - f0).abs() < 2.0, "{s:?}");
         assert!((s.band_hz[1] - (f0 + r * dur)).abs() < 2.0, "{s:?}");
-        // A tone: no slope.
-        let tone: Vec<f64> = (0..n)
-            .map(|i| (2.0 * std::f64::consts::PI * 37.0 * i as f64 / fs).sin())
-            .collect();
+        // A tone (no slope) and noise (no line).
+        let tone = tone(x.len(), fs);
         assert!(detect_sweep(&tone, fs).is_none());
-        // Noise (a fixed linear congruential sequence): no line.
-        let mut state = 12345u64;
-        let noise: Vec<f64> = (0..n)
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-            })
-            .collect();
-        assert!(detect_sweep(&noise, fs).is_none());
+        assert!(detect_sweep(&noise(x.len(), 12345), fs).is_none());
         // The sweep under a steady line ~27 dB over its fundamental (a lightly damped mode rung
         // all through the test): the strongest bin of every frame is the line; the sweep is
         // still found.
@@ -299,6 +279,25 @@ mod tests {
         let s = detect_sweep(&rung, fs).unwrap();
         assert!((s.rate_hz_per_s - r).abs() < 0.05 * r, "{s:?}");
         assert!((s.band_hz[1] - (f0 + r * dur)).abs() < 2.0, "{s:?}");
+    }
+
+    /// A 37 Hz tone of `n` samples at `fs`.
+    fn tone(n: usize, fs: f64) -> Vec<f64> {
+        (0..n)
+            .map(|i| (2.0 * std::f64::consts::PI * 37.0 * i as f64 / fs).sin())
+            .collect()
+    }
+
+    /// `n` samples of uniform noise (a fixed linear congruential sequence from `seed`).
+    fn noise(n: usize, mut state: u64) -> Vec<f64> {
+        (0..n)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect()
     }
 
     /// Klipper's drive as a square wave of amplitude ∝ f whose frequency rises from `f0` at
@@ -333,19 +332,7 @@ mod tests {
         assert!((s.band_hz[0] - 23.0).abs() < 1.5, "{s:?}");
         assert!((s.band_hz[1] - 32.6).abs() < 1.5, "{s:?}");
         let n = (2.0 * fs) as usize;
-        let tone: Vec<f64> = (0..n)
-            .map(|i| (2.0 * std::f64::consts::PI * 37.0 * i as f64 / fs).sin())
-            .collect();
-        assert!(detect_sweep(&tone, fs).is_none());
-        let mut state = 777u64;
-        let noise: Vec<f64> = (0..n)
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-            })
-            .collect();
-        assert!(detect_sweep(&noise, fs).is_none());
+        assert!(detect_sweep(&tone(n, fs), fs).is_none());
+        assert!(detect_sweep(&noise(n, 777), fs).is_none());
     }
 }
