@@ -15,7 +15,7 @@
 // (performance.now()), each call its own message as the page sends them.
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
-import { header, root, uptime, withWorkers } from './worker_bench.mjs';
+import { header, root, uptime, withWorkers, workerSource } from './worker_bench.mjs';
 
 const list = (v, d) => (v ? v.split(',').filter(Boolean) : d);
 const FILES = list(process.env.FILES, [
@@ -29,15 +29,7 @@ const RUNS = Number(process.env.RUNS ?? 7);
 const text = (name) => readFileSync(path.join(root, 'tests/data/klipper', name), 'utf8');
 
 // The worker: the module initialised once, the file parsed once, then each request timed.
-const WORKER = `
-let mod;
-onmessage = async ({ data }) => {
-  if (data.type === 'init') {
-    mod = await import(data.url);
-    await mod.default();
-    postMessage({ ready: true });
-    return;
-  }
+const WORKER = workerSource(`
   const { name, text, runs, warm } = data;
   const parser = new mod.RecordingParser({ fileName: name });
   parser.push(text);
@@ -61,7 +53,7 @@ onmessage = async ({ data }) => {
   }
   const modes = id.modes.map((m) => m.frequencyHz.toFixed(2) + ' Hz ζ ' + m.damping.toFixed(4)).join(', ');
   postMessage({ times, modes, pick: rank.klipper?.best ?? rank.recommended });
-};`;
+`);
 
 const load0 = header();
 const median = (v) => [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)];

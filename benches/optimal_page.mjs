@@ -20,7 +20,7 @@
 import { readFileSync } from 'node:fs';
 import { execFileSync } from 'node:child_process';
 import path from 'node:path';
-import { header, root, uptime, withWorkers } from './worker_bench.mjs';
+import { header, root, uptime, withWorkers, workerSource } from './worker_bench.mjs';
 
 const list = (v, d) => (v ? v.split(',').filter(Boolean) : d);
 const FILES = list(process.env.FILES, [
@@ -45,15 +45,7 @@ function read(name) {
 }
 
 // The worker: the module initialised once, then each request timed call by call.
-const WORKER = `
-let mod;
-onmessage = async ({ data }) => {
-  if (data.type === 'init') {
-    mod = await import(data.url);
-    await mod.default();
-    postMessage({ ready: true });
-    return;
-  }
+const WORKER = workerSource(`
   const { spectrum, options, runs, warm } = data;
   const warmups = warm ? 2 : 0;
   const f64 = (a) => Float64Array.from(a);
@@ -68,7 +60,7 @@ onmessage = async ({ data }) => {
   }
   const best = r.ranked[0];
   postMessage({ times, label: best.label, score: best.klipperScore, vibrations: best.remainingVibration });
-};`;
+`);
 
 const load0 = header();
 const results = new Map(); // `${file} ${firmware} ${module}` → times

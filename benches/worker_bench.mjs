@@ -22,9 +22,25 @@ export function header() {
 }
 
 /**
- * Runs `body(page)` with `window.__workers[i]` a module Worker of `source` initialised with
- * `modules[i]` (paths under the repository root; the source answers `{ type: 'init', url }`
- * once its module is ready), then closes the browser and the server.
+ * A worker's source: it imports and initialises the module named by its first message
+ * (`{ type: 'init', url }`), answers `{ ready: true }`, then runs `handler` (the body of an
+ * async function of `data`, with the module as `mod`) on every later message.
+ */
+export const workerSource = (handler) => `
+let mod;
+onmessage = async ({ data }) => {
+  if (data.type === 'init') {
+    mod = await import(data.url);
+    await mod.default();
+    postMessage({ ready: true });
+    return;
+  }
+${handler}
+};`;
+
+/**
+ * Runs `body(page)` with `window.__workers[i]` a module Worker of `source` (a
+ * [`workerSource`]) initialised with `modules[i]` (paths under the repository root), then closes the browser and the server.
  */
 export async function withWorkers(source, modules, body) {
   const { server, url } = await startServer({ port: 0 });
