@@ -74,7 +74,7 @@ fn frames(signal: &[f64], fs: f64, len: usize, mut each: impl FnMut(f64, &[f64],
 /// of dB over the bin's usual level. Steady lines (a mode's ringing, the slow sweep's
 /// harmonics, mains hum) are level with their own usual level and drop out. The usual level is
 /// the lower quintile of the bin's log power over the frames (at most `MAX_LEVEL_FRAMES`,
-/// evenly spread), not its mean: in a narrow sweep the drive (with its main lobe's ±2 bins)
+/// fewer for long frames, evenly spread), not its mean: in a narrow sweep the drive (with its main lobe's ±2 bins)
 /// is near each bin for much of the record and raised the mean to its own level (23–32.6 Hz
 /// at 2 Hz/s, 0.64 s frames: two thirds of the time), and the third harmonic stood higher.
 /// A bin at a fraction of the top's frequency may still be the fundamental (`fundamental`).
@@ -82,7 +82,8 @@ fn frames(signal: &[f64], fs: f64, len: usize, mut each: impl FnMut(f64, &[f64],
 fn ridge(signal: &[f64], fs: f64, len: usize) -> Vec<(f64, f64)> {
     let half = len / 2;
     let count = (signal.len().saturating_sub(len) / (len / 4).max(1) + 1).max(1);
-    let stride = count.div_ceil(MAX_LEVEL_FRAMES);
+    let most = (MAX_LEVEL_VALUES / half.max(1)).clamp(16, MAX_LEVEL_FRAMES);
+    let stride = count.div_ceil(most);
     let mut logs: Vec<f32> = Vec::new();
     let mut i = 0usize;
     frames(signal, fs, len, |_, p, _| {
@@ -131,9 +132,11 @@ fn ridge(signal: &[f64], fs: f64, len: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// The most frames a bin's usual level is read from (evenly spread over the record): 256
-/// frames of 2048 bins keep 2 MB.
+/// The most frames a bin's usual level is read from (evenly spread over the record).
 const MAX_LEVEL_FRAMES: usize = 256;
+/// The most log powers kept for the levels (4 MB of f32): a 25.6 kHz recording's 16 384-bin
+/// frames read their levels from 64 frames, a 3.2 kHz one's 2048-bin frames from 256.
+const MAX_LEVEL_VALUES: usize = 1 << 20;
 
 /// The drive's fundamental for a frame whose highest-standing bin is `top`: the bin nearest
 /// `top`/d (d = 5, 4, 3, 2, the lowest first; ±1 bin) that holds more power than `top` and
