@@ -235,6 +235,7 @@ fn a_sweep_over_a_band_without_modes_is_reported_with_a_note() {
         assert!(id.modes.is_empty(), "{:?}", id.modes);
         assert_eq!(id.notes.len(), 1, "{:?}", id.notes);
         assert!(id.notes[0].contains("no mode stands out"), "{:?}", id.notes);
+        assert!(!id.notes[0].contains("  "), "{:?}", id.notes);
     }
 }
 

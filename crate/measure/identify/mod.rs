@@ -509,7 +509,9 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         result.sweep = sweep;
         if stage.is_none() {
             result.notes.push(format!(
-                "A sweep was found ({:.1}–{:.1} Hz at {:.2} Hz/s) but no mode stands out in                  the band fitted inside it: the response there is flat, or the band is too                  narrow for this sweep rate.",
+                "A sweep was found ({:.1}–{:.1} Hz at {:.2} Hz/s) but no mode stands out in \
+                 the band fitted inside it: the response there is flat, or the band is too \
+                 narrow for this sweep rate.",
                 s.band_hz[0], s.band_hz[1], s.rate_hz_per_s
             ));
             return Ok(result);

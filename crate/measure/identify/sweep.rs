@@ -16,8 +16,9 @@
 //! drive gives way to the fundamental under it), interpolated in log power, and a straight
 //! line f(t) = f₀ + r·t fitted robustly (Theil–Sen slope, then least squares over the frames
 //! within two bins of it). A recording is a sweep when the line holds for most frames and
-//! spans at least eight frame bins (four of the shorter frames' wider bins). Its band is the line over the inlying frames, widened by half a frame's worth of sweep
-//! at each end (a frame's ridge is the mean frequency over the frame).
+//! spans at least eight frame bins (four of the shorter frames' wider bins). Its band is the
+//! line over the inlying frames, widened by half a frame's worth of sweep at each end (a
+//! frame's ridge is the mean frequency over the frame).
 //!
 //! Why it matters: a Welch average of a sweep with segments shorter than the record is lumpy
 //! (each segment sees a few hertz of the sweep), and outside the swept band the PSD is noise and
@@ -74,9 +75,10 @@ fn frames(signal: &[f64], fs: f64, len: usize, mut each: impl FnMut(f64, &[f64],
 /// of dB over the bin's usual level. Steady lines (a mode's ringing, the slow sweep's
 /// harmonics, mains hum) are level with their own usual level and drop out. The usual level is
 /// the lower quintile of the bin's log power over the frames (at most `MAX_LEVEL_FRAMES`,
-/// fewer for long frames, evenly spread), not its mean: in a narrow sweep the drive (with its main lobe's ±2 bins)
-/// is near each bin for much of the record and raised the mean to its own level (23–32.6 Hz
-/// at 2 Hz/s, 0.64 s frames: two thirds of the time), and the third harmonic stood higher.
+/// fewer for long frames, evenly spread), not its mean: in a narrow sweep the drive (with
+/// its main lobe's ±2 bins) is near each bin for much of the record and raised the mean to
+/// its own level (23–32.6 Hz at 2 Hz/s, 0.64 s frames: two thirds of the time), and the
+/// third harmonic stood higher.
 /// A bin at a fraction of the top's frequency may still be the fundamental (`fundamental`).
 /// The peak is then interpolated in log power on the frame's own spectrum.
 fn ridge(signal: &[f64], fs: f64, len: usize) -> Vec<(f64, f64)> {
