@@ -24,7 +24,7 @@ pub(super) fn detect_within(
     h: usize,
 ) -> Vec<Peak> {
     let [lo, hi] = context;
-    let sm = smoothed_db(&to_db(&psd.psd), lo, hi, h);
+    let sm = smoothed_db(&to_db(&psd.psd[lo..=hi]), 0, hi - lo, h);
     let n = sm.len();
     let (lefts, rights) = bases(&sm);
     let mut peaks = Vec::new();

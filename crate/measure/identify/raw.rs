@@ -284,7 +284,7 @@ pub(super) fn sweep_stage(
     // half-power point is fitted), as for a spectrum file's cliff (`spectrum::seeds`); the
     // others are shoulders. A response still rising into the top is `rising`'s.
     let h2 = (4 * h).min(800);
-    let heavy = smoothed_db(&to_db(&psd.psd), lo, hi, h2);
+    let heavy = smoothed_db(&to_db(&psd.psd[lo..=hi]), 0, hi - lo, h2);
     let mut peaks = detect_within(
         &psd,
         [lo, hi],
