@@ -7,26 +7,31 @@
 //   npm run build && npm run bench:measure
 //   FILES=resonances_y_three.csv,… RUNS=9 MODULES=pkg/page/recording.js,OLD/recording.js \
 //   node benches/measure_page.mjs
+//   DIR=/tmp/rand_1 RUNS=3 node benches/measure_page.mjs   # every spectrum file of a directory
 //
+// DIR (default tests/data/klipper) is where the files are read; given without FILES, every
+// resonances_*.csv and calibration_data_*.csv in it (e.g. a batch of
+// benches/reference/sweep_random.py) is timed, and the slowest total is printed at the end.
 // MODULES (paths under the repository root, served as the page is) lists builds of the module
 // to compare (e.g. another commit's pkg/page copied under the repository); their runs
 // alternate, file by file, so a machine whose load moves treats them alike. Per file and
 // module: the median and range of RUNS timed calls after 2 warm-ups, wall time in the worker
 // (performance.now()), each call its own message as the page sends them.
-import { readFileSync } from 'node:fs';
+import { readdirSync, readFileSync } from 'node:fs';
 import path from 'node:path';
 import { header, root, uptime, withWorkers, workerSource } from './worker_bench.mjs';
 
 const list = (v, d) => (v ? v.split(',').filter(Boolean) : d);
-const FILES = list(process.env.FILES, [
-  'resonances_x_m1.csv', 'resonances_y_three.csv', 'resonances_y_two38x14.csv', 'resonances_x_cliff133.csv',
-  'calibration_data_y_three.csv',
-]);
+const DIR = path.resolve(root, process.env.DIR ?? 'tests/data/klipper');
+const FILES = list(process.env.FILES, process.env.DIR
+  ? readdirSync(DIR).filter((f) => /^(resonances|calibration_data)_.*\.csv$/.test(f)).sort()
+  : ['resonances_x_m1.csv', 'resonances_y_three.csv', 'resonances_y_two38x14.csv', 'resonances_x_cliff133.csv',
+    'calibration_data_y_three.csv']);
 const MODULES = list(process.env.MODULES, ['pkg/page/recording.js']);
 const RUNS = Number(process.env.RUNS ?? 7);
 
 /** A Klipper spectrum file as the page's parser reads it (done in the worker: not timed). */
-const text = (name) => readFileSync(path.join(root, 'tests/data/klipper', name), 'utf8');
+const text = (name) => readFileSync(path.join(DIR, name), 'utf8');
 
 // The worker: the module initialised once, the file parsed once, then each request timed.
 const WORKER = workerSource(`
@@ -58,6 +63,7 @@ const WORKER = workerSource(`
 const load0 = header();
 const median = (v) => [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)];
 const range = (v) => `${Math.min(...v).toFixed(0)}–${Math.max(...v).toFixed(0)}`;
+const slowest = MODULES.map(() => ({ file: '', total: 0 }));
 await withWorkers(WORKER, MODULES, async (page) => {
   for (const file of FILES) {
     const results = MODULES.map(() => ({ identify: [], klipper: [], total: [], modes: '', pick: '' }));
@@ -75,10 +81,12 @@ await withWorkers(WORKER, MODULES, async (page) => {
     }
     MODULES.forEach((m, i) => {
       const r = results[i];
+      if (median(r.total) > slowest[i].total) slowest[i] = { file, total: median(r.total) };
       console.log(`${file} [${m}]: identify ${median(r.identify).toFixed(0)} ms (${range(r.identify)}), `
         + `klipper ${median(r.klipper).toFixed(0)} ms (${range(r.klipper)}), total ${median(r.total).toFixed(0)} ms `
         + `(${range(r.total)}), ${r.total.length} runs; modes ${r.modes}`);
     });
   }
 });
+MODULES.forEach((m, i) => console.log(`slowest [${m}]: ${slowest[i].file}, total ${slowest[i].total.toFixed(0)} ms (median)`));
 console.log(`machine: ${load0.replace(/.*load/, 'load')} at the start, ${uptime().replace(/.*load/, 'load')} at the end`);
