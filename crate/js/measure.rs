@@ -255,7 +255,7 @@ fn psd_to_js(psd: &Psd) -> Result<JsValue, JsValue> {
 }
 
 /// `parseRecording(text, { timeColumn?, timeScale?, fileName?, channel? })` → for a recording
-/// `{ format: 'klipper' | 'csv', timeColumn, sampleRateHz, startTimeS, durationS, rows,
+/// `{ format: 'klipper' | 'rrf' | 'csv', timeColumn, sampleRateHz, startTimeS, durationS, rows,
 /// resampled, timing: { meanStepS, minStepS, maxStepS, jitter }, channels: [{ name, values:
 /// Float64Array }] }`; for a Klipper spectrum file `{ format: 'klipperResonances' |
 /// 'klipperCalibration', fileName, axis: 'x' | 'y' | 'z' | null, frequencyHz, psdX, psdY, psdZ,

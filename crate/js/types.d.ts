@@ -637,9 +637,10 @@ export interface RecordingChannel {
   values: Float64Array;
 }
 
-/** A recording (`parseRecording` of a Klipper raw or CSV recording). */
+/** A recording (`parseRecording` of a Klipper raw, RepRapFirmware accelerometer or CSV
+ * recording; RepRapFirmware's values in mm/s² on channels `accel_x` …). */
 export interface Recording {
-  format: "klipper" | "csv";
+  format: "klipper" | "csv" | "rrf";
   timeColumn: string;
   sampleRateHz: number;
   startTimeS: number;

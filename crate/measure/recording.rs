@@ -3,6 +3,14 @@
 //! - Klipper's raw accelerometer files (`ACCELEROMETER_MEASURE`, `TEST_RESONANCES` with raw
 //!   output) are read as they are: a header `#time,accel_x,accel_y,accel_z`, then one row per
 //!   sample, times in seconds.
+//! - RepRapFirmware's accelerometer files (`M956`, `0:/sys/accelerometer/*.csv`): a header
+//!   `Sample,X,Y,Z` (the axes recorded), one row per sample numbered from 0 with the
+//!   accelerations in g, and a last line `Rate <Hz>, overflows <n>` (RepRapFirmware
+//!   src/Accelerometers/Accelerometers.cpp, `AccelerometerTaskCode` and `CreateFile`). The
+//!   times are the sample numbers over that rate; the values are turned into mm/s² (× 9806.65,
+//!   Klipper's unit) in channels `accel_x`, `accel_y`, `accel_z`. A file with overflows (samples
+//!   lost), no rate line (unless `timeScale` gives the sample period) or a firmware message in
+//!   place of data is refused with the line and the reason.
 //! - Any other CSV: the first line that is not a `#` comment names the columns (a leading `#`
 //!   is allowed, as in Klipper's files); one column is the time — named `time`, `t`,
 //!   `timestamp`, `time_s`, `seconds` … (case-insensitive; or any name given as
@@ -87,6 +95,37 @@ pub enum RecordingFormat {
     /// Klipper's `calibration_data_<axis>_<name>.csv` (the PSDs, then `shapers:` and one
     /// column per fitted shaper).
     KlipperCalibration,
+    /// RepRapFirmware's accelerometer file (`M956`: `Sample,X,Y,Z`, values in g, then
+    /// `Rate <Hz>, overflows <n>`), read into mm/s².
+    Rrf,
+}
+
+/// Standard gravity, mm/s² per g: RepRapFirmware writes accelerations in g.
+pub const G_MM_S2: f64 = 9806.65;
+
+/// A RepRapFirmware accelerometer header (`Sample` then 1–3 distinct axes of `X`, `Y`, `Z`):
+/// the channels' names in Klipper's terms.
+fn rrf_channels(names: &[String]) -> Option<Vec<String>> {
+    if names.first().map(String::as_str) != Some("Sample") || !(2..=4).contains(&names.len()) {
+        return None;
+    }
+    let axes = &names[1..];
+    let known = axes.iter().all(|a| matches!(a.as_str(), "X" | "Y" | "Z"));
+    let distinct = (0..axes.len()).all(|i| !axes[..i].contains(&axes[i]));
+    (known && distinct).then(|| {
+        axes.iter()
+            .map(|a| format!("accel_{}", a.to_ascii_lowercase()))
+            .collect()
+    })
+}
+
+/// What a RepRapFirmware file's last line says: its sample rate (Hz) and how many times the
+/// accelerometer's buffer overflowed (`Rate 1344, overflows 0`).
+fn rrf_trailer(text: &str) -> Option<(f64, u64)> {
+    let rest = text.strip_prefix("Rate ")?;
+    let (rate, overflows) = rest.split_once(',')?;
+    let overflows = overflows.trim().strip_prefix("overflows")?.trim();
+    Some((rate.trim().parse().ok()?, overflows.parse().ok()?))
 }
 
 /// One signal column.
@@ -250,6 +289,8 @@ struct Header {
     separator: Separator,
     klipper: bool,
     spectrum: Option<SpectrumLayout>,
+    /// A RepRapFirmware accelerometer file: its channels' names (`accel_x` …).
+    rrf: Option<Vec<String>>,
 }
 
 /// A shaper column's name and frequency: `zv(59.8)` (`save_calibration_data` writes
@@ -300,6 +341,8 @@ pub struct RecordingParser {
     columns: Vec<Vec<f64>>,
     failed: Option<RecordingError>,
     header_line_seen: usize,
+    /// A RepRapFirmware file's last line: (its line, the rate in Hz).
+    rrf_rate: Option<(usize, f64)>,
 }
 
 /// The value in column `column` (1-based, named `name`) of line `n`: present, a number,
@@ -370,6 +413,7 @@ impl RecordingParser {
             columns: Vec::new(),
             failed: None,
             header_line_seen: 0,
+            rrf_rate: None,
         }
     }
 
@@ -453,7 +497,51 @@ impl RecordingParser {
         if text.starts_with('#') {
             return Ok(());
         }
+        if self.header.as_ref().is_some_and(|h| h.rrf.is_some()) {
+            return self.rrf_line(n, text);
+        }
         self.row(n, text)
+    }
+
+    /// A line of a RepRapFirmware accelerometer file after its header: a data row, the last
+    /// line `Rate <Hz>, overflows <n>`, or one of the firmware's messages where the data
+    /// stopped (`Failed to collect data from accelerometer`, `Data incomplete`, `Received bad
+    /// data`, …).
+    fn rrf_line(&mut self, n: usize, text: &str) -> Result<(), RecordingError> {
+        if let Some((line, _)) = self.rrf_rate {
+            return Err(RecordingError::at(
+                n,
+                format!("nothing may follow RepRapFirmware's `Rate …` line (line {line})"),
+            ));
+        }
+        if text.starts_with(|c: char| c.is_ascii_digit()) {
+            return self.row(n, text);
+        }
+        let Some((rate, overflows)) = rrf_trailer(text) else {
+            return Err(RecordingError::at(
+                n,
+                format!("RepRapFirmware wrote `{text}` here: the recording is incomplete"),
+            ));
+        };
+        if overflows > 0 {
+            return Err(RecordingError::at(
+                n,
+                format!(
+                    "the accelerometer's buffer overflowed {overflows} time{} during this \
+                     recording (`{text}`): samples are missing, so its times and frequencies \
+                     would be wrong; record again at a lower rate (M955 S) or with fewer samples",
+                    if overflows == 1 { "" } else { "s" }
+                ),
+            ));
+        }
+        if !(rate.is_finite() && rate > 0.0) {
+            return Err(RecordingError::at(
+                n,
+                format!("the sample rate must be positive, got `{text}`"),
+            ));
+        }
+        self.rrf_rate = Some((n, rate));
+        Ok(())
     }
 
     /// A data row (line `n`, trimmed, after the header): its values checked and stored.
@@ -591,6 +679,19 @@ impl RecordingParser {
             return self.spectrum_header(names, separator);
         }
         let wanted = self.options.time_column.as_deref();
+        if let Some(channels) = rrf_channels(&names).filter(|_| wanted.is_none()) {
+            self.columns = vec![Vec::new(); names.len() - 1];
+            self.header = Some(Header {
+                names,
+                time: 0,
+                separator,
+                klipper: false,
+                spectrum: None,
+                rrf: Some(channels),
+            });
+            self.header_line_seen = n;
+            return Ok(());
+        }
         let time = names.iter().position(|s| is_time_name(s, wanted));
         let Some(time) = time else {
             if commented {
@@ -639,6 +740,7 @@ impl RecordingParser {
             separator,
             klipper,
             spectrum: None,
+            rrf: None,
         });
         self.header_line_seen = n;
         Ok(())
@@ -713,6 +815,7 @@ impl RecordingParser {
                 shapers,
                 runs,
             }),
+            rrf: None,
         });
         self.header_line_seen = n;
         Ok(())
@@ -778,6 +881,9 @@ impl RecordingParser {
                 ),
             ));
         }
+        if header.rrf.is_some() {
+            self.rrf_to_seconds()?;
+        }
         let t0 = self.times[0];
         let duration = self.times[n - 1] - t0;
         let mean = duration / (n - 1) as f64;
@@ -793,12 +899,21 @@ impl RecordingParser {
         // `%.6f`: two roundings of 0.5 µs) or 0.1 % are even.
         let uneven = (hi - mean).max(mean - lo) > (1e-3 * mean).max(1.01e-6);
         let names = header.names;
+        let signal_names: Vec<String> = match &header.rrf {
+            Some(channels) => channels.clone(),
+            None => names
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != header.time)
+                .map(|(_, name)| name.clone())
+                .collect(),
+        };
         let channels = self
             .columns
             .into_iter()
-            .zip(names.iter().enumerate().filter(|(j, _)| *j != header.time))
-            .map(|(values, (_, name))| Channel {
-                name: name.clone(),
+            .zip(signal_names)
+            .map(|(values, name)| Channel {
+                name,
                 values: if uneven {
                     resample(&self.times, &values, mean)
                 } else {
@@ -807,7 +922,9 @@ impl RecordingParser {
             })
             .collect();
         Ok(Parsed::Recording(Recording {
-            format: if header.klipper {
+            format: if header.rrf.is_some() {
+                RecordingFormat::Rrf
+            } else if header.klipper {
                 RecordingFormat::Klipper
             } else {
                 RecordingFormat::Csv
@@ -831,6 +948,29 @@ impl RecordingParser {
                 self.times
             },
         }))
+    }
+
+    /// A RepRapFirmware file's sample numbers into seconds (over its `Rate` line's rate, or
+    /// as `timeScale` already made them) and its values from g into mm/s².
+    fn rrf_to_seconds(&mut self) -> Result<(), RecordingError> {
+        let scaled = self.options.time_scale != 1.0;
+        match self.rrf_rate {
+            Some((_, rate)) if !scaled => self.times.iter_mut().for_each(|t| *t /= rate),
+            Some(_) => {}
+            None if scaled => {}
+            None => {
+                return Err(RecordingError::at(
+                    self.line.max(1),
+                    "RepRapFirmware's accelerometer file ends with `Rate <Hz>, overflows <n>`; \
+                     this one has no such line (cut short?), so its sample rate is unknown: \
+                     give the sample period as the timeScale option (1/rate, s)",
+                ));
+            }
+        }
+        for column in &mut self.columns {
+            column.iter_mut().for_each(|v| *v *= G_MM_S2);
+        }
+        Ok(())
     }
 
     fn finish_spectrum(
