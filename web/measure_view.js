@@ -161,7 +161,7 @@ function fillChannels(names, selected) {
 }
 
 const FORMAT = {
-  klipper: 'Klipper raw accelerometer file', csv: 'CSV',
+  klipper: 'Klipper raw accelerometer file', csv: 'CSV', rrf: 'RepRapFirmware accelerometer file (M956)',
   klipperResonances: 'Klipper resonances file (PSD)', klipperCalibration: 'Klipper calibration data (PSD and fitted shapers)',
 };
 

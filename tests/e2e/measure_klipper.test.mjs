@@ -105,6 +105,34 @@ test('a raw Klipper recording: the axis chart, Klipper\'s table and the config',
   await page.close();
 });
 
+/** The test set's raw recording of a 47.3 Hz, ζ 0.08 mode written as RepRapFirmware's M956
+ * writes a file (src/Accelerometers/Accelerometers.cpp): `Sample,X,Y,Z`, sample numbers, g to 4
+ * decimals, then `Rate <Hz>, overflows 0`. */
+function rrfFile() {
+  const rows = readFileSync(new URL('raw_data_x_single47z08.csv', DATA), 'utf8').trim().split('\n').slice(1)
+    .map((line) => line.split(',').map(Number));
+  const rate = Math.round((rows.length - 1) / (rows[rows.length - 1][0] - rows[0][0]));
+  const g = (v) => (v / 9806.65).toFixed(4);
+  const body = rows.map((r, k) => `${k},${g(r[1])},${g(r[2])},${g(r[3])}`).join('\n');
+  return { name: '0_2026-12-05_10.00.00.csv', mimeType: 'text/csv', buffer: Buffer.from(`Sample,X,Y,Z\n${body}\nRate ${rate}, overflows 0\n`) };
+}
+
+test('a RepRapFirmware accelerometer file (M956): its kind said, its mode and Klipper\'s table', async () => {
+  const { page, problems } = await env.page({ width: 1280, height: 1000 });
+  await page.setInputFiles('#measure-file', rrfFile());
+  await page.waitForSelector('#measure-modes tbody tr[data-mode]', { timeout: 180000 });
+  await page.waitForFunction(() => [...document.querySelectorAll('canvas.klipper-chart')].some((c) => c.dataset.drawn), null, { timeout: 180000 });
+  assert.match(await page.textContent('#measure'), /RepRapFirmware accelerometer file \(M956\)/);
+  const found = await page.$$eval('#measure-modes tbody td[data-frequency]', (tds) => tds.map((td) => Number(td.dataset.frequency)));
+  assert.ok(found.some((f) => Math.abs(f / 47.3 - 1) < 0.01), `47.3 Hz found: ${found}`);
+  const rows = await page.$$eval('table.klipper-table tbody tr', (trs) => trs.map((r) => r.dataset.family));
+  assert.ok(rows.length >= 5, JSON.stringify(rows));
+  assert.ok((await canvasInfo(page, 'klipper-chart-0')).ink > 5000, 'the chart has ink');
+  await page.locator('#measure').screenshot({ path: `${SCREENSHOTS}measure-rrf.png` });
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('resonances and calibration files, X and Y together, then a bad file keeps the result', async () => {
   const { page, problems } = await env.page({ width: 1280, height: 1000 });
   await drop(page, ['resonances_x_single47z08.csv', 'calibration_data_y_two38x14.csv'], ['x', 'y']);
