@@ -271,8 +271,12 @@ function drawAxes() {
 /** The config text of each axis's pick for `firmware` (firmwareConfig, crate/export/firmware.rs). */
 function configText(firmware) {
   const picks = (result?.axes ?? []).map((a) => ({ a, r: a.klipper?.rows?.[a.klipper.selected] })).filter((p) => p.r);
-  const axes = picks.filter(({ a }) => /^[xyz]$/.test(a.axis));
-  const notes = picks.filter((p) => !axes.includes(p))
+  const named = picks.filter(({ a }) => /^[xyz]$/.test(a.axis));
+  // RepRapFirmware's M593 sets one shaper for every axis (it has no axis parameter), so a lone
+  // file with no axis in its name (M956 names its files by board and date) still gives it.
+  const anyAxis = firmware === 'rrf' && !named.length && picks.length === 1;
+  const axes = anyAxis ? [{ ...picks[0], a: { ...picks[0].a, axis: 'x' } }] : named;
+  const notes = anyAxis ? [] : picks.filter((p) => !named.includes(p))
     .map(({ a }) => `${a.axis}: not an X, Y or Z axis (Klipper names the files resonances_x_…, calibration_data_y_…): left out.`);
   if (!axes.length) return { text: '', warnings: notes };
   const out = firmwareConfig({

@@ -128,6 +128,13 @@ test('a RepRapFirmware accelerometer file (M956): its kind said, its mode and Kl
   const rows = await page.$$eval('table.klipper-table tbody tr', (trs) => trs.map((r) => r.dataset.family));
   assert.ok(rows.length >= 5, JSON.stringify(rows));
   assert.ok((await canvasInfo(page, 'klipper-chart-0')).ink > 5000, 'the chart has ink');
+  // The file names no axis (M956 names it by board and date): Klipper's per-axis config leaves
+  // it out and says why; RepRapFirmware's M593, one shaper for every axis, is written.
+  assert.equal(await page.inputValue('#measure-config-text'), '');
+  assert.match(await page.textContent('#measure-config-notes'), /not an X, Y or Z axis/);
+  await page.selectOption('#measure-config-format', 'rrf');
+  const pick = await page.$eval('table.klipper-table tbody tr.best', (r) => [r.dataset.family, Number(r.dataset.frequency)]);
+  assert.match(await page.inputValue('#measure-config-text'), new RegExp(`^M593 P"${pick[0]}" F${Number(pick[1].toFixed(1))} S0\\.1\n`));
   await page.locator('#measure').screenshot({ path: `${SCREENSHOTS}measure-rrf.png` });
   assert.deepEqual(problems, []);
   await page.close();
