@@ -134,6 +134,39 @@ fn random_excitation_one_mode_with_noise_and_drift() {
     assert!(id.free_decay.is_none());
 }
 
+/// Short white-noise records of one broad mode (40 Hz, ζ 0.08, 10 s at 1 kHz, 16 draws):
+/// the identified frequency's scatter. A record's information is limited (docs/measured-data.md,
+/// *White-noise records*); the fit must not waste it. With the fitted range reaching to three
+/// times the mode's frequency (a stationary excitation, `fit_range`) the RMS error is 0.68 %
+/// on these draws, against 0.81 % when the range stopped at 1.8 times (the floor, the direct
+/// term and the excitation's slope then traded against the frequency).
+/// Natively only: 16 records.
+#[test]
+fn white_noise_records_of_a_broad_mode_scatter_little() {
+    let mut rng = Rng(40);
+    let fs = 1000.0;
+    let mut squares = 0.0;
+    let draws = 16;
+    for _ in 0..draws {
+        let mut x = random_response(&[(40.0, 0.08, 1.0)], fs, 10_000, &mut rng);
+        corrupt(&mut x, fs, 0.05, 0.2, &mut rng);
+        let id = identify(&x, &IdentifyOptions::new(fs)).unwrap();
+        let f = id
+            .modes
+            .iter()
+            .map(|m| m.frequency_hz)
+            .min_by(|a, b| (a - 40.0).abs().total_cmp(&(b - 40.0).abs()))
+            .unwrap();
+        squares += (f / 40.0 - 1.0).powi(2);
+    }
+    let rms = (squares / draws as f64).sqrt();
+    eprintln!(
+        "RMS frequency error over {draws} records: {:.3} %",
+        100.0 * rms
+    );
+    assert!(rms < 0.0075, "RMS frequency error {:.3} %", 100.0 * rms);
+}
+
 #[wasm_bindgen_test(unsupported = test)]
 fn random_excitation_two_modes() {
     let mut rng = Rng(2);

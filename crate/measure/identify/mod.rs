@@ -256,6 +256,7 @@ fn local_fits(psd: &Psd, locals: &[raw::Local], kind: SignalKind, slots: &mut Ve
             enbw_bins: psd.enbw_bins,
             band: l.band,
             sweep_end_hz: None,
+            stationary: false,
         };
         let seed = Seed {
             frequency_hz: l.half.estimate.frequency_hz,
@@ -559,6 +560,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         enbw_bins: psd.enbw_bins,
         band,
         sweep_end_hz: result.sweep.map(|s| s.band_hz[1]),
+        stationary: result.sweep.is_none(),
     };
     // A response rising into a sweep's end: as for a spectrum file's cliff
     // (`identify_spectrum`), a mode seeded past the band, reported as cut off unless the fit
@@ -668,6 +670,7 @@ pub fn identify_spectrum(
         enbw_bins: psd.enbw_bins,
         band: [f_lo, f_hi],
         sweep_end_hz: end.map(|e| spectrum::end_hz(&grid, e)),
+        stationary: false,
     };
     // A response still rising into the sweep's end: fitted with a mode seeded past the band
     // (its flank would otherwise be read as modes under the cliff), and reported as cut off
