@@ -999,6 +999,52 @@ fn modes_of(
 mod tests {
     use super::*;
 
+    /// A test's model input on the even grid `f` (`psd` all ones): the window `window` of
+    /// 2500 points (Kaiser β = 6 when Kaiser), a band of 10–150 Hz, the sweep's end at
+    /// `end`, not normalised, not stationary; tests change fields with `..`.
+    fn input_on<'a>(
+        f: &'a [f64],
+        psd: &'a [f64],
+        window: WindowKind,
+        kind: SignalKind,
+        end: Option<f64>,
+    ) -> ModelInput<'a> {
+        ModelInput {
+            frequency_hz: f,
+            psd,
+            resolution_hz: f[1] - f[0],
+            even: true,
+            window: Some(WindowSpec {
+                kind: window,
+                length: 2500,
+                symmetric: false,
+                beta: 6.0,
+            }),
+            klipper_normalized: false,
+            kind,
+            enbw_bins: 1.0,
+            band: [10.0, 150.0],
+            sweep_end_hz: end,
+            stationary: false,
+        }
+    }
+
+    /// The problem of fitting `input` on `bins` about `f_ref` (every log PSD 0).
+    fn problem_on<'a>(input: &'a ModelInput<'a>, bins: &[usize], f_ref: f64) -> Problem<'a> {
+        Problem {
+            input,
+            logs: vec![0.0; bins.len()],
+            ln_rel: bins
+                .iter()
+                .map(|&k| (input.frequency_hz[k] / f_ref).ln())
+                .collect(),
+            bins: bins.to_vec(),
+            f_ref,
+            power: input.kind.power(),
+            kernels: kernel_cache(),
+        }
+    }
+
     /// `Problem::eval` with its shared fine grid gives what the model's definition gives,
     /// computed here point by point from `response`. Near a narrow mode (40 Hz, ζ 0.01: two
     /// bins wide) or the sweep's end, a bin is the kernel's sum of the model at f + (j − J)Δf/q.
@@ -1015,35 +1061,10 @@ mod tests {
             SignalKind::Velocity,
             SignalKind::Position,
         ] {
-            let input = ModelInput {
-                frequency_hz: &f,
-                psd: &psd,
-                resolution_hz: df,
-                even: true,
-                window: Some(WindowSpec {
-                    kind: WindowKind::Rectangular,
-                    length: 2500,
-                    symmetric: false,
-                    beta: 6.0,
-                }),
-                klipper_normalized: false,
-                kind,
-                enbw_bins: 1.0,
-                band: [10.0, 150.0],
-                sweep_end_hz: Some(end),
-                stationary: false,
-            };
+            let input = input_on(&f, &psd, WindowKind::Rectangular, kind, Some(end));
             let bins: Vec<usize> = (25..375).filter(|k| k % 7 != 3).collect();
             let f_ref = 50.0;
-            let problem = Problem {
-                input: &input,
-                logs: vec![0.0; bins.len()],
-                ln_rel: bins.iter().map(|&k| (f[k] / f_ref).ln()).collect(),
-                bins: bins.clone(),
-                f_ref,
-                power: kind.power(),
-                kernels: kernel_cache(),
-            };
+            let problem = problem_on(&input, &bins, f_ref);
             let m = 2;
             let x = [
                 40f64.ln(),
@@ -1121,34 +1142,13 @@ mod tests {
         ] {
             for (klipper_normalized, even) in [(false, true), (true, true), (false, false)] {
                 let input = ModelInput {
-                    frequency_hz: &f,
-                    psd: &psd,
-                    resolution_hz: df,
                     even,
-                    window: Some(WindowSpec {
-                        kind: WindowKind::Kaiser,
-                        length: 2500,
-                        symmetric: false,
-                        beta: 6.0,
-                    }),
                     klipper_normalized,
-                    kind,
                     enbw_bins: 1.5,
-                    band: [10.0, 150.0],
-                    sweep_end_hz: Some(120.0),
-                    stationary: false,
+                    ..input_on(&f, &psd, WindowKind::Kaiser, kind, Some(120.0))
                 };
                 let bins: Vec<usize> = (25..375).filter(|k| k % 7 != 3).collect();
-                let f_ref = 50.0;
-                let problem = Problem {
-                    input: &input,
-                    logs: vec![0.0; bins.len()],
-                    ln_rel: bins.iter().map(|&k| (f[k] / f_ref).ln()).collect(),
-                    bins: bins.clone(),
-                    f_ref,
-                    power: kind.power(),
-                    kernels: kernel_cache(),
-                };
+                let problem = problem_on(&input, &bins, 50.0);
                 let q = 8;
                 let kern = problem.kernel(q);
                 let mut jac = DMatrix::zeros(bins.len(), x.len());
@@ -1203,33 +1203,13 @@ mod tests {
             WindowKind::Hann,
         ] {
             let input = ModelInput {
-                frequency_hz: &f,
-                psd: &psd,
-                resolution_hz: df,
-                even: true,
-                window: Some(WindowSpec {
-                    kind: window,
-                    length: 2048,
-                    symmetric: false,
-                    beta: 6.0,
-                }),
                 klipper_normalized: true,
-                kind: SignalKind::Acceleration,
                 enbw_bins: 1.5,
                 band: [5.0, 200.0],
-                sweep_end_hz: None,
-                stationary: false,
+                ..input_on(&f, &psd, window, SignalKind::Acceleration, None)
             };
             let bins: Vec<usize> = (4..190).collect();
-            let problem = Problem {
-                input: &input,
-                logs: vec![0.0; bins.len()],
-                ln_rel: bins.iter().map(|&k| (f[k] / 60.0).ln()).collect(),
-                bins,
-                f_ref: 60.0,
-                power: 2,
-                kernels: kernel_cache(),
-            };
+            let problem = problem_on(&input, &bins, 60.0);
             for z in [0.002f64, 0.005, 0.01, 0.02] {
                 for fm in [20.3f64, 47.7, 81.1] {
                     let x = [fm.ln(), z.ln(), 0.02, 0.3, 2.0, 1e-6f64.ln()];
