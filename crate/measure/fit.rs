@@ -109,9 +109,11 @@ pub(crate) fn minimise<P: LeastSquares>(
 
 /// [`minimise`] for one of several starts whose best sum so far is `bound`: a start still
 /// above twice the bound whose last [`STALL_ITERATIONS`] iterations took less than 1 % off its
-/// sum is given up (its sum returned as it stands). At that pace it could not come under the
-/// bound within the iterations left: a multi-start fit keeps the same least sum and spends
-/// nothing on the starts that crawl into a worse minimum.
+/// sum is given up (its sum returned as it stands). At that pace halving its sum would take
+/// some 280 iterations, against the 60 the joint fit allows; a crawl can still end in a sudden
+/// drop, so this is a judgement of pace, not a proof. On the test set and the random and raw
+/// batches the fits kept were the same with and without it, and the starts that crawl into a
+/// worse minimum cost nothing more.
 pub(crate) fn minimise_below<P: LeastSquares>(
     problem: &mut P,
     x0: &[f64],
