@@ -582,3 +582,103 @@ fn no_vibration_bound_is_a_floor_below_klippers_pick() {
     );
     assert!(b.score < 0.95 * r.rows[0].klipper.score, "{b:?}");
 }
+
+/// Why custom shapers keep positive amplitudes although Kalico (and RepRapFirmware's parser)
+/// take negative ones: Klipper's smoothing (`_get_shaper_smoothing`) is the 180° reversal's
+/// shortfall a/2 Σ Aᵢ(tᵢ − c)² — exact for a positive shaper, but a signed moment that negative
+/// amplitudes drive to zero or below while the toolhead overshoots the reversal instead. The
+/// convex floor program (`optimal_grid.rs`) with amplitudes ≥ −0.1 and |offsets| bounded found
+/// the shaper below on `resonances_x_z008f47.csv` with no remaining vibration (2026-12-06,
+/// docs/measured-data.md, *Where the score is left*): Klipper would score it ≤ 0. The corner
+/// simulation (an independent computation: the shaped trapezoids of a planned path) shows what
+/// it does: the reversal overshoots by more than Klipper's MZV falls short, and the square's
+/// corners deviate twice as far.
+#[test]
+fn negative_amplitudes_game_klippers_smoothing() {
+    use input_shaping::corner::{corner, plan, square, Axis, MotionLimits};
+    use input_shaping::measure::klipper::klipper_shaper;
+    use input_shaping::plant::ModalPlant;
+    use input_shaping::smoothing::smoothing;
+    use input_shaping::Mode;
+    let impulses = [
+        (0.0, -0.102_256),
+        (0.016_996, 1.152_753),
+        (0.036_265, -0.025_779),
+        (0.041_305, 0.030_989),
+        (0.045_875, -0.118_385),
+        (0.047_486, 0.062_678),
+    ];
+    let negative = Shaper::new(
+        impulses
+            .iter()
+            .map(|&(time, amplitude)| Impulse { time, amplitude })
+            .collect(),
+    )
+    .unwrap()
+    .normalized()
+    .unwrap();
+    let mzv = klipper_shaper("mzv", 48.2, 0.1)
+        .unwrap()
+        .normalized()
+        .unwrap();
+    // The nozzle follows the shaped command exactly (no mode takes part): only the shaper acts.
+    let rigid = ModalPlant::new(vec![Mode::new(48.2, 0.1).unwrap()], vec![0.0]).unwrap();
+    let limits = MotionLimits {
+        velocity: 200.0,
+        accel: 5000.0,
+        square_corner_velocity: 5.0,
+    };
+    let reversal = plan(&[[0.0, 0.0], [40.0, 0.0], [0.0, 0.0]], &limits).unwrap();
+    let square = plan(&square(40.0).unwrap(), &limits).unwrap();
+    let print = |p, s| {
+        corner(
+            p,
+            [
+                Axis {
+                    plant: &rigid,
+                    shaper: Some(s),
+                },
+                Axis {
+                    plant: &rigid,
+                    shaper: Some(s),
+                },
+            ],
+            2e-5,
+            0.1,
+        )
+        .unwrap()
+    };
+    // Signed shortfall of the reversal at x = 40 (negative: the nozzle went past it).
+    let shortfall = |s| {
+        40.0 - print(&reversal, s).nozzle[0]
+            .iter()
+            .fold(f64::MIN, |m, &x| m.max(x))
+    };
+    let peak = |s| {
+        print(&square, s)
+            .deviation
+            .iter()
+            .fold(0.0_f64, |m, d| m.max(d.abs()))
+    };
+    let (sm_mzv, sm_neg) = (
+        smoothing(&mzv, 5000.0, 5.0).unwrap(),
+        smoothing(&negative, 5000.0, 5.0).unwrap(),
+    );
+    // For MZV Klipper's figure is the reversal's shortfall (its definition, to the sampling).
+    assert!(
+        (shortfall(&mzv) - sm_mzv).abs() < 1e-3,
+        "{} vs {sm_mzv}",
+        shortfall(&mzv)
+    );
+    // The negative shaper: Klipper's figure ≤ 0 — a better score than any positive shaper —
+    // while the nozzle overshoots the reversal by more than MZV falls short of it and the
+    // square's corners deviate more than twice as far.
+    assert!(sm_neg <= 0.0, "{sm_neg}");
+    assert!(-shortfall(&negative) > sm_mzv, "{}", shortfall(&negative));
+    assert!(
+        peak(&negative) > 2.0 * peak(&mzv),
+        "{} vs {}",
+        peak(&negative),
+        peak(&mzv)
+    );
+}
