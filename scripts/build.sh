@@ -5,7 +5,7 @@
 # Each wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
 # library with the crate (-Z build-std) at the module's opt-level ("z", or 2 for the page's
 # main thread and its measured-data worker; below) and LTO, with panic locations left out (-Z location-detail=none; panic
-# messages stay): same code, same results, ~24 KB less gzip (docs/page-performance.md, *Shipped size*). std's
+# messages stay, but for the main thread's module: below): same code, same results, ~24 KB less gzip (docs/page-performance.md, *Shipped size*). std's
 # `optimize_for_size` feature would save 7 KB more, but it formats floats (every tick label)
 # with Dragon4 only, not Grisu. Without that toolchain (setup could not install it), or with
 # STABLE=1, it is built by stable Rust.
@@ -62,9 +62,17 @@ fi
 # 4.0 KB less gzip (276 286 -> 272 280 B), the page benchmark's updates no slower in
 # alternated runs; every dependency at "s" saved the same but its 4-shaper mode edit was
 # ~0.2 ms slower at p50, and "z" saved no more (docs/page-performance.md, *Shipped size*, 2026-12-05).
-# build_module FEATURES OUT_DIR OUT_NAME [OPT_LEVEL] [DEPS_OPT_LEVEL]
+# The main thread's module (playground) is also built with `-C panic=immediate-abort`: a panic
+# (a bug: nothing reachable from the API panics) traps as `unreachable` with no message, and the
+# panic machinery with every panic message is left out, 12.1 KB gzip (276 068 -> 263 959 B,
+# 2026-12-06, docs/page-performance.md, *Shipped size*): the first load's budget. The other
+# modules keep their messages; a panic seen on the page is reproduced with the same input
+# through pkg/input_shaping.js or natively, which report it.
+# build_module FEATURES OUT_DIR OUT_NAME [OPT_LEVEL] [DEPS_OPT_LEVEL] [PANIC]
 build_module() {
-  local features=$1 out=$2 name=$3 opt=${4:-z} deps=${5:-} dir=""
+  local features=$1 out=$2 name=$3 opt=${4:-z} deps=${5:-} panic=${6:-} dir=""
+  local flags="-Z location-detail=none"
+  [ -n "$panic" ] && flags="$flags -Z unstable-options -C panic=$panic"
   local -x CARGO_PROFILE_RELEASE_OPT_LEVEL=$opt # this module's cargo builds only
   local config=()
   if [ -n "$deps" ]; then
@@ -75,11 +83,12 @@ build_module() {
     done
   fi
   if [ "$use_nightly" = 1 ]; then
-    # Its own target directory: other RUSTFLAGS and std would rebuild the stable builds' cache.
-    if RUSTFLAGS="-Z location-detail=none" cargo "+$nightly" build "${config[@]+"${config[@]}"}" --release --lib --target "$target" \
-      --no-default-features --features "$features" --target-dir target/shipped -Z build-std=std,panic_abort; then
-      dir=target/shipped
-      how="$nightly, std built with it at opt-level $opt"
+    # Its own target directory: other RUSTFLAGS and std would rebuild the stable builds' cache
+    # (and another panic strategy, the other modules' one).
+    if RUSTFLAGS="$flags" cargo "+$nightly" build "${config[@]+"${config[@]}"}" --release --lib --target "$target" \
+      --no-default-features --features "$features" --target-dir "target/shipped${panic:+-$panic}" -Z build-std=std,panic_abort; then
+      dir=target/shipped${panic:+-$panic}
+      how="$nightly, std built with it at opt-level $opt${panic:+, panic=$panic}"
     else
       echo "[build] the $nightly build failed: building with stable Rust instead (larger wasm)" >&2
       use_nightly=0
@@ -129,11 +138,11 @@ if [ -x node_modules/.bin/wasm-opt ]; then
 fi
 stamps=1 # 0 once a module fell back to stable Rust: nothing is stamped, the next build retries
 
-# module_key FEATURES OPT_LEVEL WASM_OPT_LEVEL [DEPS_OPT_LEVEL]
+# module_key FEATURES OPT_LEVEL WASM_OPT_LEVEL [DEPS_OPT_LEVEL] [PANIC]
 module_key() {
   bash scripts/stamp.sh --files crate Cargo.toml Cargo.lock .cargo/config.toml rust-toolchain \
     rust-toolchain.toml scripts/build.sh scripts/stamp.sh scripts/nightly.sh scripts/guard-freed.mjs -- \
-    "features=$1" "opt-level=$2" "wasm-opt=$3" "deps-opt-level=${4:-}" "nightly=$use_nightly" "$rustc_version" \
+    "features=$1" "opt-level=$2" "wasm-opt=$3" "deps-opt-level=${4:-}" "panic=${5:-}" "nightly=$use_nightly" "$rustc_version" \
     "$bindgen_version" "binaryen=$binaryen_version"
 }
 # outputs OUT_DIR NAME: what wasm-bindgen writes (and wasm-opt rewrites)
@@ -148,12 +157,12 @@ write_stamp() {
   { echo "$1"; outputs "$3" "$4" | xargs sha256sum; } > "$2.tmp" && mv "$2.tmp" "$2"
 }
 
-# module FEATURES OUT_DIR NAME OPT_LEVEL WASM_OPT_LEVEL [DEPS_OPT_LEVEL]: builds it unless up to date; its
-# wasm-opt runs in the background while the next one compiles.
+# module FEATURES OUT_DIR NAME OPT_LEVEL WASM_OPT_LEVEL [DEPS_OPT_LEVEL] [PANIC]: builds it unless up
+# to date; its wasm-opt runs in the background while the next one compiles.
 module() {
-  local features=$1 out=$2 name=$3 opt=$4 level=$5 deps=${6:-} key stamp
+  local features=$1 out=$2 name=$3 opt=$4 level=$5 deps=${6:-} panic=${7:-} key stamp
   stamp="$out/.$name.stamp"
-  key=$(module_key "$features" "$opt" "$level" "$deps")
+  key=$(module_key "$features" "$opt" "$level" "$deps" "$panic")
   if up_to_date "$key" "$stamp"; then
     echo "[build] $out/$name.js ($features): up to date, kept (FORCE=1 rebuilds)"
     return
@@ -165,7 +174,7 @@ module() {
   fi
   rm -f "$stamp"
   local before=$use_nightly
-  build_module "$features" "$out" "$name" "$opt" "$deps"
+  build_module "$features" "$out" "$name" "$opt" "$deps" "$panic"
   [ "$use_nightly" = "$before" ] || stamps=0
   local write=$stamps
   { shrink "$out/${name}_bg.wasm" "$level" && if [ "$write" = 1 ]; then write_stamp "$key" "$stamp" "$out" "$name"; fi; } &
@@ -177,7 +186,7 @@ pids=()
 stale=0
 module js-api pkg input_shaping z z
 if [ "$what" != --library ]; then
-  module js-playground pkg/page playground 2 2 s
+  module js-playground pkg/page playground 2 2 s immediate-abort
   module js-designer,solver pkg/page designer z z
   module js-recording pkg/page recording 2 2
   module js-corner pkg/page corner 2 2
