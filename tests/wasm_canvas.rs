@@ -279,6 +279,63 @@ fn render_playground_draws_every_chart_and_the_mismatch_moves_the_response() {
     }
 }
 
+/// Mismatch per mode and in damping (issue 23 item 2): the simulated plant's mode i is the
+/// model's × `mismatch` × `modeMismatch[i]` with `actualDamping[i]` (the model's when missing or
+/// null). Checked against the products written out, against the exact shaper's promise (a
+/// per-mode ratio that undoes the common one leaves ZVD's V = 0 at the exact modes, which
+/// another damping breaks), and every bad entry named by its index.
+#[wasm_bindgen_test]
+fn render_playground_takes_a_mismatch_per_mode_and_in_damping() {
+    let run = |view: &str| {
+        let state = JSON::parse(&format!(
+            r#"{{"modes":[{{"frequencyHz":2,"damping":0.05}},{{"frequencyHz":5,"damping":0.02}}],
+                "shapers":[{{"family":"zvd"}}],
+                "view":{{"command":{{"kind":"trapezoid","distance":1,"maxVelocity":0.8,"maxAcceleration":8}},{view}}}}}"#
+        ))
+        .unwrap();
+        wasm::render_playground(state, JsValue::NULL)
+    };
+    let numbers = |v: JsValue| -> Vec<f64> {
+        js_sys::Array::from(&v)
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let sim = |r: &JsValue, key: &str| {
+        Reflect::get(&Reflect::get(r, &"simulation".into()).unwrap(), &key.into()).unwrap()
+    };
+    let residual = |r: &JsValue| {
+        let first = js_sys::Array::from(&Reflect::get(r, &"results".into()).unwrap()).get(0);
+        sim(&first, "residualVibrationPercent").as_f64().unwrap()
+    };
+    let r = run(r#""mismatch":1.1,"modeMismatch":[1,0.9],"actualDamping":[null,0.1]"#).unwrap();
+    let hz = numbers(sim(&r, "plantModesHz"));
+    assert!(
+        (hz[0] - 2.2).abs() < 1e-12 && (hz[1] - 4.95).abs() < 1e-12,
+        "{hz:?}"
+    );
+    assert_eq!(numbers(sim(&r, "plantDamping")), vec![0.05, 0.1]);
+    assert!(residual(&r) > 1e-3, "mismatched: {}", residual(&r));
+    // Per-mode ratios undoing the common one: the model's modes, ZVD's exact cancellation.
+    let undone = format!(r#""mismatch":1.1,"modeMismatch":[{0},{0}]"#, 1.0 / 1.1);
+    let exact = run(&undone).unwrap();
+    assert!(residual(&exact) < 1e-6, "{}", residual(&exact));
+    // The same with mode 2's damping changed: vibration left.
+    let damped = run(&format!(r#"{},"actualDamping":[null,0.2]"#, undone)).unwrap();
+    assert!(residual(&damped) > 1e-3, "{}", residual(&damped));
+    for (view, field) in [
+        (r#""modeMismatch":[1,-1]"#, "view.modeMismatch[1]"),
+        (r#""modeMismatch":[1,1,1]"#, "view.modeMismatch"),
+        (r#""actualDamping":[null,1.5]"#, "view.actualDamping[1]"),
+        (r#""actualDamping":[0.1,0.1,0.1]"#, "view.actualDamping"),
+        (r#""modeMismatch":["1"]"#, "view.modeMismatch[0]"),
+    ] {
+        let err: js_sys::Error = run(view).unwrap_err().dyn_into().unwrap();
+        let got = Reflect::get(&err, &"field".into()).unwrap().as_string();
+        assert_eq!(got.as_deref(), Some(field), "{view}: {:?}", err.message());
+    }
+}
+
 /// `renderPlayground` keeps the last frame's designs and analyses and reuses them while only
 /// the simulation's inputs change. Through a sequence of edits — mismatch, Vtol, square corner
 /// velocity, a mode's frequency, the family, the mismatch again — every frame's shaper,

@@ -5,8 +5,9 @@
 // state needs any more by ending this worker (web/main.js, "Solved designs").
 // Messages in: { module } first (the designer module, compiled by the page; null: fetch it
 // here), then { id, request } (`design`'s spec: { family, modes, …parameters }). Out:
-// { id, shaper } (as `design` returns it) or { id, error: { kind, field, message } }.
-import init, { design } from '../pkg/page/designer.js';
+// { id, shaper } (as `design` returns it; a sampled shaper with `report`, its cost report as
+// `sampledReport` gives it) or { id, error: { kind, field, message } }.
+import init, { design, sampledReport } from '../pkg/page/designer.js';
 
 let ready = null;
 self.onmessage = async ({ data }) => {
@@ -22,7 +23,13 @@ self.onmessage = async ({ data }) => {
     return;
   }
   try {
-    postMessage({ id, shaper: design(request) });
+    if (request?.family === 'sampled') {
+      // The design and its cost against the minimum-norm shaper (issue 23 item 2), in one call.
+      const { impulses, duration, ...report } = sampledReport(request);
+      postMessage({ id, shaper: { impulses, duration }, report });
+    } else {
+      postMessage({ id, shaper: design(request) });
+    }
   } catch (e) {
     postMessage({ id, error: { kind: e?.kind, field: e?.field, message: e?.message ?? String(e) } });
   }

@@ -14,7 +14,7 @@ export const QUIET_MS = 150;
 const KEPT_DESIGNS = 64;
 /** Everything the scheduler keeps, in one object. */
 export const scheduler = {
-  /** key → { pending: true, request, since } | { shaper } | { error, retry? } */
+  /** key → { pending: true, request, since } | { shaper, report? (a sampled shaper's cost) } | { error, retry? } */
   designs: new Map(),
   /** The keys the last frame waited for. */
   wantedKeys: new Set(),
@@ -128,7 +128,7 @@ function runDesign(key) {
 }
 
 /** The worker's answer: kept, the next design started and the page redrawn with it. */
-function answered(d, { id, shaper, error }) {
+function answered(d, { id, shaper, report, error }) {
   if (d !== scheduler.designer || id !== d.id || !d.key) return; // from a worker since ended, or late
   // A design back for a state already left (a slider being dragged, the next step not drawn
   // yet): holding the charts for each next one would make the whole page follow the drag at
@@ -142,7 +142,7 @@ function answered(d, { id, shaper, error }) {
   // An error without a kind is a trap (the core's errors all have one): the module may be
   // left in a bad state, so the next design starts a fresh worker.
   const trapped = error && !error.kind;
-  scheduler.designs.set(d.key, shaper ? { shaper } : { error, retry: failedToLoad || trapped });
+  scheduler.designs.set(d.key, shaper ? { shaper, report } : { error, retry: failedToLoad || trapped });
   d.key = null;
   if (failedToLoad || trapped) {
     d.worker.terminate();

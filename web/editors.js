@@ -44,7 +44,12 @@ function modeRow(mode, i) {
   });
   zSlider.addEventListener('input', () => { z.value = zSlider.value; page.state.modes[i].damping = Number(zSlider.value); syncSliders(); page.changed(); });
   const remove = el('button', { type: 'button', class: 'remove', 'aria-label': `Remove mode ${i + 1}`, disabled: page.state.modes.length <= 1 }, '×');
-  remove.addEventListener('click', () => { page.state.modes.splice(i, 1); rebuild(); page.changed(true); });
+  remove.addEventListener('click', () => {
+    page.state.modes.splice(i, 1);
+    for (const key of PER_MODE) if (page.state.view[key]) setEntries(key, page.state.view[key].filter((_, j) => j !== i));
+    rebuild();
+    page.changed(true);
+  });
   return el('div', { class: 'card mode', dataset: { fieldGroup: `modes[${i}]` } },
     el('div', { class: 'card-head' }, el('strong', {}, `Mode ${i + 1}`), remove),
     field('Frequency (Hz)', f, el('div', { class: 'pair' }, fSlider, f)),
@@ -127,6 +132,42 @@ export function commandFields() {
   });
 }
 
+// ---------- mismatch per mode and in damping (issue 23 item 2) ----------
+/** `view.modeMismatch[i]` (rᵢ, default 1) and `view.actualDamping[i]` (default null: the model's). */
+const PER_MODE = ['modeMismatch', 'actualDamping'];
+const DEFAULTS = { modeMismatch: 1, actualDamping: null };
+
+/** Sets `view[key]` to `list` without its trailing defaults (none left: no key, the plain ratio). */
+function setEntries(key, list) {
+  const out = [...list];
+  while (out.length && (out[out.length - 1] ?? null) === DEFAULTS[key]) out.pop();
+  if (out.length) page.state.view[key] = out;
+  else delete page.state.view[key];
+}
+
+/** One row per mode: its own ratio rᵢ and its actual damping ratio (blank: the defaults). */
+function modeMismatchRows() {
+  const view = page.state.view;
+  const box = (key, i) => {
+    const v = view[key]?.[i];
+    const input = el('input', {
+      id: `${key}-${i}`, type: 'number', step: 'any', inputmode: 'decimal', placeholder: key === 'modeMismatch' ? '1' : 'model’s',
+      value: v == null || v === DEFAULTS[key] ? '' : String(v), dataset: { field: `view.${key}[${i}]` },
+    });
+    input.addEventListener('input', () => {
+      const list = [...(page.state.view[key] ?? [])];
+      while (list.length <= i) list.push(DEFAULTS[key]);
+      list[i] = input.value.trim() === '' ? DEFAULTS[key] : readNumber(input);
+      setEntries(key, list);
+      page.changed();
+    });
+    return input;
+  };
+  $('mode-mismatch').replaceChildren(...page.state.modes.map((_, i) => el('div', { class: 'pair' },
+    field(`Mode ${i + 1}: rᵢ`, box('modeMismatch', i)), field(`Mode ${i + 1}: actual ζ`, box('actualDamping', i)))));
+  if (PER_MODE.some((k) => view[k])) $('mode-mismatch-group').open = true;
+}
+
 // The plant's fields (issue 23 item 2): web/plant_view.js, fetched when a plant other than the
 // modal one is first shown.
 let plantView = null;
@@ -158,6 +199,7 @@ export function rebuild() {
   $('scv').value = String(page.state.view.scv ?? '');
   $('mismatch').value = String(page.state.view.mismatch ?? '');
   if (Number.isFinite(page.state.view.mismatch)) $('mismatch-slider').value = String(page.state.view.mismatch);
+  modeMismatchRows();
   $('plant-kind').value = page.state.view.plant?.kind ?? 'modal';
   plantEditors();
   $('command-kind').value = page.state.view.command?.kind ?? 'step';

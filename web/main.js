@@ -198,7 +198,10 @@ function render(st, canvases) {
       };
       drawn.designed = kept.map((i) => scheduler.designs.get(keys[i])?.shaper ?? null);
       try {
-        return { result: api.renderPlayground(drawn, canvases), kept, left, waiting, waitingKeys: waiting.map((i) => keys[i]) };
+        const result = api.renderPlayground(drawn, canvases);
+        // A sampled shaper the worker designed (bounds) brings its cost report along (issue 23 item 2).
+        kept.forEach((i, j) => { result.results[j].sampled ??= scheduler.designs.get(keys[i])?.report ?? null; });
+        return { result, kept, left, waiting, waitingKeys: waiting.map((i) => keys[i]) };
       } catch (e) {
         const j = shaperOf(e);
         k = j < 0 ? -1 : kept[j];

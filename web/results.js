@@ -39,9 +39,17 @@ export function showResults(result, st, kept) {
   // target (long, low-frequency shapers): said in words, not left as a bare 0.
   const maxAccel = (a) => (a == null ? '∞' : a === 0 ? '0 (none keeps smoothing ≤ 0.12 mm)' : fmt(a, 5));
   rows.push(['Klipper max accel, smoothing ≤ 0.12 mm (mm/s²)', (r) => (r.klipper == null ? 'n/a' : maxAccel(r.klipper.maxAccel))]);
+  // A sampled shaper's cost report (Kamel, Lange & Hirzinger; issue 23 item 2): rows only when one is compared.
+  if (results.some((r) => r.family === 'sampled')) {
+    const of = (f) => (r) => (r.sampled ? f(r.sampled) : '—');
+    rows.push(['Sampled: ramp delay τ, eq. 10 (s)', of((s) => fmt(s.rampDelay, 4))]);
+    rows.push(['Sampled: cost J_q, eq. 17 (∫e² dt + AᵀQA)', of((s) => `${fmt(s.cost.total, 4)} (${fmt(s.cost.controlError, 4)} + ${fmt(s.cost.amplitudePenalty, 4)})`)]);
+    rows.push(['Sampled: J_q of the minimum-norm shaper', of((s) => fmt(s.baselineCost.total, 4))]);
+    rows.push(['Sampled: cost reduction against it (%)', of((s) => fmtPct(s.costReduction))]);
+  }
   syncRows($('summary').tBodies[0], rows.map(([name, f]) => [name, ...results.map((r) => f(r))]));
 
-  showSimulation(result, color);
+  showSimulation(result, color, st);
 
   if (rebuildIf($('impulse-tables'), labels, () => results.map((r, k) => el('table', { class: 'impulses', id: `impulses-${k}` },
     el('caption', {}, el('span', { class: 'swatch', style: `background:${color(k)}` }), r.label),
@@ -95,7 +103,7 @@ function toggleImpulseTable(k) {
 }
 
 /** The simulated move's metrics: the unshaped command and every shaper (`color(k)` of result k). */
-function showSimulation(result, color) {
+function showSimulation(result, color, st) {
   const sim = result.simulation;
   const columns = [{ label: 'Unshaped', color: '#6e6e6e', m: sim.unshaped },
     ...result.results.map((r, k) => ({ label: r.label, color: color(k), m: r.simulation }))];
@@ -114,7 +122,11 @@ function showSimulation(result, color) {
   ];
   syncRows($('simulation-summary').tBodies[0], rows.map(([name, f]) => [name, ...columns.map((c) => (c.m ? f(c.m) : '—'))]));
   const plant = { pendulum: 'nonlinear pendulum', twoMass: 'two-mass spring' }[sim.plant] ?? 'modal plant';
-  $('simulation-note').textContent = `(${plant}, actual modes ${sim.plantModesHz.map((f) => fmt(f, 4)).join(', ')} Hz = model × ${fmt(sim.mismatch, 4)}; ${sim.samples} samples over ${fmt(sim.duration, 4)} s)`;
+  // With a mismatch per mode or in damping (issue 23 item 2), each actual mode with its ζ.
+  const perMode = st.view.modeMismatch || st.view.actualDamping;
+  const actual = perMode ? sim.plantModesHz.map((f, i) => `${fmt(f, 4)} Hz (ζ ${fmt(sim.plantDamping[i], 3)})`).join(', ')
+    : `${sim.plantModesHz.map((f) => fmt(f, 4)).join(', ')} Hz = model × ${fmt(sim.mismatch, 4)}`;
+  $('simulation-note').textContent = `(${plant}, actual modes ${actual}; ${sim.samples} samples over ${fmt(sim.duration, 4)} s)`;
 }
 
 export function showExport() {

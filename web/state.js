@@ -243,6 +243,8 @@ function checkView(view, fail) {
   for (const [k, v] of Object.entries(view)) {
     if (['vtol', 'scv', 'mismatch', 'mapShaper', 'fromHz', 'toHz', 'points', 'samples', 'duration', 'dampingTo'].includes(k)) {
       if (!num(v)) fail(`view.${k} must be a number`);
+    } else if (k === 'modeMismatch' || k === 'actualDamping') {
+      if (!Array.isArray(v) || v.length > MAX_MODES || !v.every(num)) fail(`view.${k} must be a list of at most ${MAX_MODES} numbers`);
     } else if (k === 'command') {
       checkCommand(v, 'view.command', fail);
     } else if (k === 'plant') {

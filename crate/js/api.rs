@@ -366,7 +366,7 @@ pub fn ramp_delay(
 /// rampDelay, cost: { total, controlError, amplitudePenalty }, baselineCost, costReduction }`:
 /// the design `design(spec)` returns plus its ramp delay (eq. 10) and cost J_q (eq. 17), and the
 /// cost of the minimum-norm shaper under the same constraints.
-#[cfg(feature = "js-api")]
+#[cfg(any(feature = "js-api", feature = "js-designer"))]
 #[wasm_bindgen(js_name = sampledReport, unchecked_return_type = "SampledReport")]
 pub fn sampled_report(
     #[wasm_bindgen(unchecked_param_type = "SampledDesignSpec")] spec: JsValue,

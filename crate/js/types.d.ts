@@ -550,6 +550,10 @@ export interface PlaygroundView {
   scv?: number;
   pixelRatio?: number;
   mismatch?: number;
+  /** Per-mode ratio rᵢ (0.05 … 20): mode i's actual frequency is the model's × mismatch × rᵢ. */
+  modeMismatch?: number[];
+  /** Per-mode actual damping ratio (0 … 0.99); null: the model's. */
+  actualDamping?: (number | null)[];
   command?: CommandSpec;
   plant?:
     | { kind: "modal" }
@@ -595,6 +599,9 @@ export interface PlaygroundShaperResult {
   centroidDelay: number | null;
   klipper: KlipperFigures | null;
   simulation: Metrics | null;
+  /** A `sampled` shaper's cost report (`sampledReport`'s figures); null for the other families
+   * and for one passed in `designed` (a bounded one: its baseline needs the solver). */
+  sampled: { rampDelay: number; cost: Cost; baselineCost: Cost; costReduction: number } | null;
 }
 
 export interface PlaygroundResult {
@@ -608,6 +615,7 @@ export interface PlaygroundResult {
     mismatch: number;
     plant: "modal" | "twoMass" | "pendulum";
     plantModesHz: number[];
+    plantDamping: number[];
     duration: number;
     samplePeriod: number;
     samples: number;

@@ -390,6 +390,38 @@ test('a sampled shaper with an amplitude bound, which only the solver designs, g
   await page.close();
 });
 
+test('a sampled shaper’s cost report in the Numbers table: the JS API’s sampledReport, bounded (the worker) or not', async () => {
+  const { page, problems } = await env.page();
+  const spec = (bound) => ({ family: 'sampled', periodS: 0.012, impulses: 36, delaySamples: 17, weight: 0.1, derivatives: 1, plantGain: 8e-4, objective: 'controlError', ...bound });
+  const modes = [{ frequencyHz: 30 / (2 * Math.PI), damping: 0.02 }];
+  const fmt = (x, d) => (Number.isFinite(x) ? String(Number(x.toPrecision(d))) : '—');
+  const rows = () => page.$$eval('#summary tbody tr', (r) => Object.fromEntries(r.map((x) => [x.cells[0].textContent, [...x.cells].slice(1).map((c) => c.textContent)])));
+  for (const bound of [{}, { amplitudeMin: 0 }]) {
+    await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, { modes, shapers: [spec(bound), { family: 'zvd' }] });
+    await settle(page);
+    await page.waitForFunction(() => document.querySelectorAll('#impulses-0 tbody tr').length > 0);
+    const lib = await page.evaluate(async (s) => {
+      const api = await import('/pkg/input_shaping.js');
+      await api.default({ module_or_path: '/pkg/input_shaping_bg.wasm' });
+      return api.sampledReport(s);
+    }, { ...spec(bound), modes });
+    const r = await rows();
+    const what = JSON.stringify(bound);
+    assert.deepEqual(r['Sampled: ramp delay τ, eq. 10 (s)'], [fmt(lib.rampDelay, 4), '—'], what);
+    assert.deepEqual(r['Sampled: cost J_q, eq. 17 (∫e² dt + AᵀQA)'], [`${fmt(lib.cost.total, 4)} (${fmt(lib.cost.controlError, 4)} + ${fmt(lib.cost.amplitudePenalty, 4)})`, '—'], what);
+    assert.deepEqual(r['Sampled: J_q of the minimum-norm shaper'], [fmt(lib.baselineCost.total, 4), '—'], what);
+    assert.deepEqual(r['Sampled: cost reduction against it (%)'], [fmt(lib.costReduction * 100, 4), '—'], what);
+    // Kamel et al. §6: the control-error shaper costs less than the minimum-norm one.
+    assert.ok(lib.costReduction > 0, `${what}: ${lib.costReduction}`);
+  }
+  // No sampled shaper compared: no such rows.
+  await page.evaluate(() => { location.hash = `#state=${encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: 2, damping: 0.05 }], shapers: [{ family: 'zvd' }] }))}`; });
+  await settle(page);
+  assert.ok(!Object.keys(await rows()).some((k) => k.startsWith('Sampled')));
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('a slow solved design never freezes the page, and one nobody wants any more is stopped', async () => {
   const { page, problems } = await env.page();
   // SI at I = 0.3 over six modes: about two minutes of solving (README, "What takes longer

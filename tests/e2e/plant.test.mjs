@@ -1,5 +1,6 @@
 // End-to-end: the simulated plant's editors (issue 23 item 2) in headless Chromium — the
-// two-mass spring with its rigid-body mode and the crane's hoisting. The simulated-move table on the page against the JS API's own `simulate` (the
+// two-mass spring with its rigid-body mode, the crane's hoisting, and the mismatch per mode and
+// in damping. The simulated-move table on the page against the JS API's own `simulate` (the
 // library's pkg/, run in the page) on the same plant, command and samples; pixels on the
 // response chart; a bad value named at its field while the last good charts stay; the state in
 // the URL; the editor not fetched by the default page; no console errors; screenshots.
@@ -167,4 +168,48 @@ test('hostile plant values in a link are refused as a state (web/state.js)', asy
     assert.equal(state, undefined, JSON.stringify(plant));
     assert.match(error, /view\.plant/, error);
   }
+});
+
+test('a mismatch per mode and in damping: the table is the library’s simulation of those modes; a bad ratio is named; the URL; a removed mode takes its entries along', async () => {
+  const modes = [{ frequencyHz: 2, damping: 0.05 }, { frequencyHz: 5, damping: 0.02 }];
+  const command = { kind: 'trapezoid', distance: 1, maxVelocity: 0.8, maxAcceleration: 8 };
+  const state = { modes, shapers: [{ family: 'zv' }, { family: 'zvd' }], view: { command, mismatch: 1.1, duration: 10, samples: 1001, plant: { kind: 'modal' } } };
+  const { page, problems } = await env.page({ hash: toHash(state) });
+  await settle(page);
+  assert.equal(await page.$eval('#mode-mismatch-group', (n) => n.open), false, 'closed while unused');
+  assert.match(await note(page), /actual modes 2\.2, 5\.5 Hz = model × 1\.1;/);
+  const before = (await canvasInfo(page, 'response-chart')).hash;
+  await page.click('#mode-mismatch-group > summary');
+  await type(page, 'modeMismatch-1', '0.9');
+  await type(page, 'actualDamping-1', '0.1');
+  await settle(page);
+  // Mode 2: 5 Hz × 1.1 × 0.9 = 4.95 Hz at ζ 0.1; mode 1 as the common ratio makes it.
+  assert.match(await note(page), /actual modes 2\.2 Hz \(ζ 0\.05\), 4\.95 Hz \(ζ 0\.1\);/);
+  const actual = [{ frequencyHz: 2.2, damping: 0.05 }, { frequencyHz: 4.95, damping: 0.1 }];
+  const lib = await library(page, { kind: 'modal', modes: actual }, command, ['zv', 'zvd'], modes);
+  assertSame(await table(page), lib.metrics);
+  const good = (await canvasInfo(page, 'response-chart')).hash;
+  assert.notEqual(good, before, 'the response follows');
+  assert.deepEqual((await stateOf(page)).view.modeMismatch, [1, 0.9]);
+  assert.deepEqual((await stateOf(page)).view.actualDamping, [null, 0.1]);
+  await page.screenshot({ path: `${SCREENSHOTS}plant-mode-mismatch-1280x800.png`, fullPage: true });
+
+  // A bad ratio: named at its field, the last good charts kept; cleared, back to the default 1.
+  await type(page, 'modeMismatch-0', '-1');
+  await settle(page);
+  assert.match(await errorAt(page, 'modeMismatch-0'), /0\.05/);
+  assert.equal((await canvasInfo(page, 'response-chart')).hash, good);
+  await type(page, 'modeMismatch-0', '');
+  await settle(page);
+  assert.equal(await errorAt(page, 'modeMismatch-0'), '');
+  assert.equal((await canvasInfo(page, 'response-chart')).hash, good);
+
+  // Removing mode 1 takes its entries along: mode 2's stay with it.
+  await page.click('button[aria-label="Remove mode 1"]');
+  await settle(page);
+  const st = await stateOf(page);
+  assert.deepEqual([st.view.modeMismatch, st.view.actualDamping], [[0.9], [0.1]]);
+  assert.match(await note(page), /actual modes 4\.95 Hz \(ζ 0\.1\);/);
+  assert.deepEqual(problems, []);
+  await page.close();
 });

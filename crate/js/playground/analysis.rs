@@ -29,6 +29,24 @@ pub(super) struct ShaperResult {
     pub klipper: Option<crate::smoothing::KlipperFigures>,
     /// Metrics of the shaped move on the simulated (mismatched) plant.
     pub simulation: Option<Metrics>,
+    /// A `sampled` shaper's cost report (Kamel, Lange & Hirzinger; `sampledReport` without the
+    /// impulses); `None` for the other families and for a sampled shaper designed elsewhere (an
+    /// amplitude or increment bound: its minimum-norm baseline needs the solver).
+    pub sampled: Option<SampledFigures>,
+}
+
+/// The cost report of a `sampled` shaper on the page: `sampledReport`'s figures.
+#[derive(Serialize, Clone)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct SampledFigures {
+    /// τ of eq. 10, s.
+    pub ramp_delay: f64,
+    /// J_q (eq. 17) of the design.
+    pub cost: design::sampled::Cost,
+    /// J_q of the minimum-norm amplitudes under the same constraints.
+    pub baseline_cost: design::sampled::Cost,
+    /// 1 − cost.total / baselineCost.total.
+    pub cost_reduction: f64,
 }
 
 /// The part of a frame that depends on the designs and the analysis settings only, not on the
@@ -149,9 +167,23 @@ fn designs(frame: &Frame) -> Result<(Vec<Shaper>, Vec<ShaperResult>), Error> {
     let mut results = Vec::with_capacity(frame.specs.len());
     let mut shapers = Vec::with_capacity(frame.specs.len());
     for (k, spec) in frame.specs.iter().enumerate() {
-        let shaper = match frame.designed.get(k) {
-            Some(Some(shaper)) => shaper.clone(),
-            _ => design::design_for(spec, modes).map_err(|e| e.within(&format!("shapers[{k}]")))?,
+        let at = |e: Error| e.within(&format!("shapers[{k}]"));
+        let elsewhere = frame.designed.get(k).cloned().flatten();
+        let shaper = match &elsewhere {
+            Some(shaper) => shaper.clone(),
+            None => design::design_for(spec, modes).map_err(at)?,
+        };
+        let sampled = match (spec, &elsewhere) {
+            (ShaperSpec::Sampled(s), None) => {
+                let r = design::sampled::report(modes, s).map_err(at)?;
+                Some(SampledFigures {
+                    ramp_delay: r.ramp_delay,
+                    cost: r.cost,
+                    baseline_cost: r.baseline_cost,
+                    cost_reduction: r.cost_reduction,
+                })
+            }
+            _ => None,
         };
         let curve = vibration::sensitivity(&shaper, &frame.sensitivity).map_err(in_view)?;
         let insensitivity =
@@ -173,6 +205,7 @@ fn designs(frame: &Frame) -> Result<(Vec<Shaper>, Vec<ShaperResult>), Error> {
             centroid_delay: shaper.centroid_delay(),
             klipper,
             simulation: None,
+            sampled,
         });
         shapers.push(shaper);
     }

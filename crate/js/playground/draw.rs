@@ -205,10 +205,25 @@ fn simulation_charts(
             ViewPlant::Pendulum { hoist: None, .. } => ", nonlinear pendulum",
             ViewPlant::Pendulum { hoist: Some(_), .. } => ", nonlinear pendulum, hoisted",
         };
-        let caption = format!(
-            "Simulated response (actual f = model × {}{plant_name})",
-            (frame.view.mismatch * 1e4).round() / 1e4
-        );
+        let round = |x: f64| (x * 1e4).round() / 1e4;
+        let caption = if frame.view.mode_mismatch.is_empty() && frame.view.actual_damping.is_empty()
+        {
+            format!(
+                "Simulated response (actual f = model × {}{plant_name})",
+                round(frame.view.mismatch)
+            )
+        } else {
+            // Per-mode mismatch: the actual modes themselves (their ζ in the page's note).
+            let modes: Vec<String> = sim
+                .plant_modes
+                .iter()
+                .map(|m| round(m.frequency_hz()).to_string())
+                .collect();
+            format!(
+                "Simulated response (actual modes {} Hz{plant_name})",
+                modes.join(", ")
+            )
+        };
         chart::draw_response(
             &b.into_drawing_area(),
             &sim.unshaped,

@@ -36,6 +36,8 @@ struct SimulationSummary {
     mismatch: f64,
     plant: &'static str,
     plant_modes_hz: Vec<f64>,
+    /// The simulated plant's damping ratios (the model's unless `view.actualDamping` gives them).
+    plant_damping: Vec<f64>,
     duration: f64,
     sample_period: f64,
     samples: usize,
@@ -67,7 +69,8 @@ struct PlaygroundResult {
 ///
 /// `state = { modes, shapers: [{ family, …parameters }] (1 … 4; or `shaper` for one),
 /// designed?: [shaper | null] (shapers designed elsewhere, by index),
-/// view: { fromHz, toHz, points, vtol, scv, pixelRatio, mismatch, command, plant, samples,
+/// view: { fromHz, toHz, points, vtol, scv, pixelRatio, mismatch, modeMismatch, actualDamping,
+/// command, plant, samples,
 /// duration, mapShaper, seriesColors, mapFrequencyPoints, mapDampingPoints, dampingTo, dampingPoints,
 /// spectrumPoints } }` (README, "JavaScript API"); `canvases = { impulses?, sensitivity?,
 /// damping?, map?, response?, command?, spectrum?, robustness? }` (HTMLCanvasElements).
@@ -76,9 +79,10 @@ struct PlaygroundResult {
 /// the unshaped and every shaped move on the plant with the mismatched modes, and draws the
 /// charts overlaid. Returns `{ results: [{ label, family, shaper, sensitivity, insensitivity,
 /// residualAtModes, centroidDelay, klipper: { smoothing, maxAccel }, simulation }],
-/// simulation: { mismatch, plant, plantModesHz, duration, samplePeriod, samples, unshaped },
+/// simulation: { mismatch, plant, plantModesHz, plantDamping, duration, samplePeriod, samples,
+/// unshaped },
 /// robustness, mapShaper, dampingTo, …the first result's fields }`. Errors name the field
-/// (`shapers[1].vtol`, `modes[0].damping`, `view.vtol`, `view.mismatch`,
+/// (`shapers[1].vtol`, `modes[0].damping`, `view.vtol`, `view.mismatch`, `view.modeMismatch[1]`,
 /// `view.command.maxVelocity`). Nothing is drawn unless everything computed, so a bad input
 /// leaves the last good charts on screen.
 #[wasm_bindgen(js_name = renderPlayground, unchecked_return_type = "PlaygroundResult")]
@@ -123,6 +127,7 @@ fn frame(state: JsValue, canvases: &JsValue) -> Result<PlaygroundResult, Error> 
                 ViewPlant::Pendulum { .. } => "pendulum",
             },
             plant_modes_hz: sim.plant_modes.iter().map(Mode::frequency_hz).collect(),
+            plant_damping: sim.plant_modes.iter().map(Mode::damping).collect(),
             duration: sim.duration,
             sample_period: sim.sample_period,
             samples: frame.samples,

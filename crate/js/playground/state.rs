@@ -58,6 +58,13 @@ pub(super) struct PlaygroundView {
     pub pixel_ratio: f64,
     /// Model mismatch of the simulation: actual frequency = model × `mismatch`.
     pub mismatch: f64,
+    /// Mismatch per mode, rᵢ (0.05 … 20; missing entries 1): mode i's actual frequency is the
+    /// model's × `mismatch` × rᵢ. At most one entry per mode.
+    pub mode_mismatch: Vec<f64>,
+    /// Actual damping ratio per mode (0 … 0.99; `null` or a missing entry: the model's). At
+    /// most one entry per mode. The two-mass spring's damping is its damper's, so it does not
+    /// take these.
+    pub actual_damping: Vec<Option<f64>>,
     /// The reference command of the simulation (as `simulate` takes it).
     pub command: CommandSpec,
     /// The simulated plant, built from the (mismatched) modes.
@@ -93,6 +100,8 @@ impl Default for PlaygroundView {
             scv: crate::smoothing::KLIPPER_SCV,
             pixel_ratio: 1.0,
             mismatch: 1.0,
+            mode_mismatch: Vec::new(),
+            actual_damping: Vec::new(),
             command: CommandSpec::Step {
                 distance: 1.0,
                 start: 0.0,
@@ -120,8 +129,8 @@ crate::tagged::tagged_enum! {
     #[derive(Debug, Clone)]
     pub(super) enum ViewPlant {
         Modal,
-        /// The two-mass spring as the library takes it (SI units); the mismatch r scales its
-        /// stiffness by r², so its frequency by r.
+        /// The two-mass spring as the library takes it (SI units); the mismatch r (× mode 1's
+        /// own ratio) scales its stiffness by r², so its frequency by r.
         TwoMass(TwoMass),
         #[serde(rename_all = "camelCase")]
         Pendulum {
@@ -415,14 +424,59 @@ fn count_in(field: &str, value: usize, lo: usize, hi: usize) -> Result<usize, Er
     }
 }
 
-/// The simulated plant of a frame: the modes with frequencies × `mismatch`.
-fn view_plant(modes: &[Mode], view: &PlaygroundView) -> Result<Plant, Error> {
+/// The frequency ratio of each mode (`mismatch` × its own) and its actual damping ratio, or the
+/// error naming the entry.
+fn mode_factors(modes: &[Mode], view: &PlaygroundView) -> Result<Vec<(f64, f64)>, Error> {
     let r = within_range("view.mismatch", view.mismatch, 0.05, 20.0)?;
-    let at_mismatch = |e: Error| Error::invalid("view.mismatch", e.to_string());
+    for (field, given) in [
+        ("view.modeMismatch", view.mode_mismatch.len()),
+        ("view.actualDamping", view.actual_damping.len()),
+    ] {
+        if given > modes.len() {
+            return Err(Error::invalid(
+                field,
+                format!("has {given} entries for {} modes", modes.len()),
+            ));
+        }
+    }
+    modes
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let own = match view.mode_mismatch.get(i) {
+                Some(&x) => within_range(&format!("view.modeMismatch[{i}]"), x, 0.05, 20.0)?,
+                None => 1.0,
+            };
+            let zeta = match view.actual_damping.get(i).copied().flatten() {
+                Some(z) => within_range(&format!("view.actualDamping[{i}]"), z, 0.0, 0.99)?,
+                None => m.damping(),
+            };
+            Ok((r * own, zeta))
+        })
+        .collect()
+}
+
+/// The simulated plant of a frame: the modes with frequencies × `mismatch` × their own ratio
+/// and their actual damping ratios.
+fn view_plant(modes: &[Mode], view: &PlaygroundView) -> Result<Plant, Error> {
+    let factors = mode_factors(modes, view)?;
     let actual = modes
         .iter()
-        .map(|m| Mode::new(m.frequency_hz() * r, m.damping()).map_err(at_mismatch))
+        .zip(&factors)
+        .enumerate()
+        .map(|(i, (m, &(r, zeta)))| {
+            Mode::new(m.frequency_hz() * r, zeta).map_err(|e| {
+                let field = if view.mode_mismatch.get(i).is_some_and(|&x| x != 1.0) {
+                    format!("view.modeMismatch[{i}]")
+                } else {
+                    "view.mismatch".to_string()
+                };
+                Error::invalid(&field, e.to_string())
+            })
+        })
         .collect::<Result<Vec<_>, _>>()?;
+    // The two-mass spring's one mode is mode 1's: its ratio scales the spring.
+    let r = factors.first().map_or(1.0, |f| f.0);
     match &view.plant {
         ViewPlant::Modal => {
             let share = 1.0 / actual.len() as f64;
