@@ -187,7 +187,8 @@ pub fn mode_residual_percent(plant: &ModalPlant, command: &Piecewise) -> Result<
 /// change the peak |value| or the turning points [`peak_valley_count`] finds. Where it is
 /// constant on every piece (`order` ≥ degree: a trapezoid's acceleration), one value per piece:
 /// both ends would be the same number (the Taylor shift of order 0 adds nothing to it), and a
-/// repeated value changes neither the peak nor [`peak_valley_count`].
+/// repeated value changes neither the peak nor [`peak_valley_count`]. Where it is quadratic or
+/// cubic, [`sample_derivative_turns`]: the ends and the turning points of each piece.
 fn sample_derivative(p: &Piecewise, order: usize) -> Vec<f64> {
     if p.degree() <= order {
         let mut out = Vec::with_capacity(p.knots().len() + 1);
@@ -199,12 +200,63 @@ fn sample_derivative(p: &Piecewise, order: usize) -> Vec<f64> {
         }
         return out;
     }
-    let per_piece = if p.degree() <= order + 1 {
-        1
+    if p.degree() <= order + 1 {
+        return sample_derivative_at(p, order, 1);
+    }
+    if p.degree() <= order + 3 {
+        return sample_derivative_turns(p, order);
+    }
+    sample_derivative_at(p, order, PER_PIECE)
+}
+
+/// [`sample_derivative`] where the derivative is quadratic or cubic on every piece (a
+/// multi-mode pulse-convolution profile's acceleration): each piece's two ends and the points
+/// inside it where the derivative turns (the roots of its own derivative, linear or quadratic:
+/// closed form). Between those it is monotone, so the peak |value| is exact (dense sampling
+/// only approaches it) and the turning points are the ones [`peak_valley_count`] would find.
+fn sample_derivative_turns(p: &Piecewise, order: usize) -> Vec<f64> {
+    let knots = p.knots();
+    let mut out = Vec::with_capacity(knots.len() * 4 + 2);
+    out.push(0.0);
+    let mut cursor = Cursor::new(p);
+    for (i, k) in knots.iter().enumerate() {
+        cursor.seek(k.time);
+        let s = cursor.state_at(k.time);
+        out.push(s[order]);
+        let Some(next) = knots.get(i + 1) else {
+            continue;
+        };
+        let h = next.time - k.time;
+        // g'(τ) = c₁ + c₂τ + c₃τ²/2 on the piece (c: the derivatives at its start).
+        let c = |j: usize| s.get(order + j).copied().unwrap_or(0.0);
+        let mut turns = stationary_points(c(1), c(2), 0.5 * c(3));
+        turns.retain(|&tau| tau > 0.0 && tau < h);
+        for tau in turns {
+            out.push(cursor.state_at(k.time + tau)[order]);
+        }
+        out.push(cursor.state_at(next.time)[order]);
+    }
+    out
+}
+
+/// The real roots of a + bτ + cτ², in increasing order (none for a constant).
+fn stationary_points(a: f64, b: f64, c: f64) -> Vec<f64> {
+    if c == 0.0 {
+        return if b == 0.0 { Vec::new() } else { vec![-a / b] };
+    }
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return Vec::new();
+    }
+    // The root of larger magnitude first, without cancellation; the other from the product.
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    let mut r = if q == 0.0 {
+        vec![0.0]
     } else {
-        PER_PIECE
+        vec![q / c, a / q]
     };
-    sample_derivative_at(p, order, per_piece)
+    r.sort_by(f64::total_cmp);
+    r
 }
 
 /// [`sample_derivative`] with `per_piece` + 1 points per piece (`per_piece` ≥ 1).
@@ -341,10 +393,18 @@ mod tests {
                 let dense = sample_derivative_at(p, order, PER_PIECE);
                 let peak = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
                 let (a, b) = (peak(&fast), peak(&dense));
-                assert!(
-                    (a - b).abs() <= 1e-12 * b.max(1.0),
-                    "order {order}: {a} vs {b}"
-                );
+                if p.degree() <= order + 1 {
+                    assert!(
+                        (a - b).abs() <= 1e-12 * b.max(1.0),
+                        "order {order}: {a} vs {b}"
+                    );
+                } else {
+                    // A quadratic or cubic derivative: its turning points, exact (below).
+                    assert!(
+                        a >= b * (1.0 - 1e-12) && a <= b * (1.0 + 1e-3),
+                        "{a} vs {b}"
+                    );
+                }
                 assert_eq!(
                     peak_valley_count(&fast),
                     peak_valley_count(&dense),
@@ -356,5 +416,71 @@ mod tests {
             }
         }
         assert!(sparse_used >= 20, "the sparse path ran {sparse_used} times");
+    }
+
+    /// Where a derivative is quadratic or cubic on every piece (the acceleration of a
+    /// multi-mode pulse-convolution profile, position of degree 4 or 5), the pieces' ends and
+    /// turning points give a peak no lower than 64 points per piece and within their spacing of
+    /// it, and the same turning points, unshaped and shaped by ZV and ZVD.
+    #[test]
+    fn turning_points_give_the_dense_peaks_where_the_derivative_is_quadratic_or_cubic() {
+        use crate::profile::{from_spec, ProfileSpec};
+        let profile = |modes: &[f64]| {
+            let spec: ProfileSpec = serde_json::from_str(&format!(
+                r#"{{"shape":"multiMode","modesHz":{modes:?},"distance":1,"duration":2}}"#
+            ))
+            .unwrap();
+            from_spec(&spec).unwrap()
+        };
+        let mut commands = vec![profile(&[1.2, 3.4, 7.9]), profile(&[1.2, 2.1, 3.4, 7.9])];
+        for f in [0.7, 2.3, 9.0] {
+            let mode = Mode::new(f, 0.05).unwrap();
+            for base in commands.clone().iter().take(2) {
+                commands.push(base.shaped(&zv(&mode).unwrap()).unwrap());
+                commands.push(base.shaped(&zvd(&mode).unwrap()).unwrap());
+            }
+        }
+        let mut turns_used = 0;
+        for p in &commands {
+            for order in 1..=3 {
+                let fast = sample_derivative(p, order);
+                let dense = sample_derivative_at(p, order, PER_PIECE);
+                let peak = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+                let (a, b) = (peak(&fast), peak(&dense));
+                assert!(
+                    a >= b * (1.0 - 1e-12) && a <= b * (1.0 + 1e-3),
+                    "degree {}, order {order}: {a} vs {b}",
+                    p.degree()
+                );
+                assert_eq!(
+                    peak_valley_count(&fast),
+                    peak_valley_count(&dense),
+                    "degree {}, order {order}",
+                    p.degree()
+                );
+                if (2..=3).contains(&(p.degree() - order)) {
+                    turns_used += 1;
+                }
+            }
+        }
+        assert!(
+            turns_used >= 20,
+            "the turning-point path ran {turns_used} times"
+        );
+    }
+
+    /// The roots of a + bτ + cτ², against the closed form.
+    #[test]
+    fn stationary_points_are_the_roots() {
+        use super::stationary_points;
+        assert_eq!(stationary_points(-6.0, 1.0, 1.0), vec![-3.0, 2.0]);
+        assert_eq!(stationary_points(2.0, -4.0, 0.0), vec![0.5]);
+        assert!(stationary_points(1.0, 0.0, 1.0).is_empty());
+        assert!(stationary_points(1.0, 0.0, 0.0).is_empty());
+        let r = stationary_points(1e-8, -1.0, 1e-8); // roots ≈ 1e-8 and 1e8, no cancellation
+        assert!(
+            (r[0] - 1e-8).abs() < 1e-20 && (r[1] - 1e8).abs() < 1e-4,
+            "{r:?}"
+        );
     }
 }
