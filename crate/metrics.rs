@@ -367,50 +367,63 @@ mod tests {
     use crate::command::{s_curve, trapezoid};
     use crate::design::zero_vibration::{zv, zvd};
     use crate::mode::Mode;
+    use crate::piecewise::Piecewise;
 
-    /// Where a derivative is linear on every piece, sampling only the pieces' ends gives the
-    /// peak and the turning points of the dense sampling (independent computation: 64 points
-    /// per piece), for trapezoids and S-curves, unshaped and shaped by ZV and ZVD at several
-    /// modes (overlapping impulse responses make pieces of every slope).
-    #[test]
-    fn piece_ends_give_the_dense_peaks_and_turning_points_where_the_derivative_is_linear() {
-        let mut commands = vec![
-            trapezoid(1.0, 0.8, 2.0, 0.0).unwrap(),
-            s_curve(1.0, 0.8, 2.0, 20.0, 0.0).unwrap(),
-            s_curve(1.0, 0.5, 100.0, 22.2, 0.1).unwrap(),
-        ];
-        for f in [0.7, 1.0, 2.3, 9.0] {
+    /// `bases`, and each shaped by ZV and ZVD at every frequency of `freqs` (ζ 0.05):
+    /// overlapping impulse responses make pieces of every slope.
+    fn with_shaped(bases: Vec<Piecewise>, freqs: &[f64]) -> Vec<Piecewise> {
+        let mut out = bases.clone();
+        for &f in freqs {
             let mode = Mode::new(f, 0.05).unwrap();
-            for base in commands.clone().iter().take(3) {
-                commands.push(base.shaped(&zv(&mode).unwrap()).unwrap());
-                commands.push(base.shaped(&zvd(&mode).unwrap()).unwrap());
+            for base in &bases {
+                out.push(base.shaped(&zv(&mode).unwrap()).unwrap());
+                out.push(base.shaped(&zvd(&mode).unwrap()).unwrap());
             }
         }
+        out
+    }
+
+    /// The `order`-th derivative of `p` sampled by [`sample_derivative`] against 64 points per
+    /// piece (an independent computation): the same turning points; the same peak where only
+    /// the pieces' ends are taken (a linear derivative), else no lower and within 1e-3 of it
+    /// (the turning points are exact, dense sampling only approaches them). Returns whether
+    /// the fast path took fewer points.
+    fn agrees_with_dense(p: &Piecewise, order: usize) -> bool {
+        let fast = sample_derivative(p, order);
+        let dense = sample_derivative_at(p, order, PER_PIECE);
+        let peak = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let (a, b) = (peak(&fast), peak(&dense));
+        let what = format!("degree {}, order {order}: {a} vs {b}", p.degree());
+        if p.degree() <= order + 1 {
+            assert!((a - b).abs() <= 1e-12 * b.max(1.0), "{what}");
+        } else {
+            assert!(a >= b * (1.0 - 1e-12) && a <= b * (1.0 + 1e-3), "{what}");
+        }
+        assert_eq!(
+            peak_valley_count(&fast),
+            peak_valley_count(&dense),
+            "{what}"
+        );
+        fast.len() < dense.len()
+    }
+
+    /// Where a derivative is linear on every piece (trapezoids and S-curves, unshaped and
+    /// shaped), sampling only the pieces' ends gives the peak and the turning points of the
+    /// dense sampling.
+    #[test]
+    fn piece_ends_give_the_dense_peaks_and_turning_points_where_the_derivative_is_linear() {
+        let commands = with_shaped(
+            vec![
+                trapezoid(1.0, 0.8, 2.0, 0.0).unwrap(),
+                s_curve(1.0, 0.8, 2.0, 20.0, 0.0).unwrap(),
+                s_curve(1.0, 0.5, 100.0, 22.2, 0.1).unwrap(),
+            ],
+            &[0.7, 1.0, 2.3, 9.0],
+        );
         let mut sparse_used = 0;
         for p in &commands {
             for order in 1..=3 {
-                let fast = sample_derivative(p, order);
-                let dense = sample_derivative_at(p, order, PER_PIECE);
-                let peak = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-                let (a, b) = (peak(&fast), peak(&dense));
-                if p.degree() <= order + 1 {
-                    assert!(
-                        (a - b).abs() <= 1e-12 * b.max(1.0),
-                        "order {order}: {a} vs {b}"
-                    );
-                } else {
-                    // A quadratic or cubic derivative: its turning points, exact (below).
-                    assert!(
-                        a >= b * (1.0 - 1e-12) && a <= b * (1.0 + 1e-3),
-                        "{a} vs {b}"
-                    );
-                }
-                assert_eq!(
-                    peak_valley_count(&fast),
-                    peak_valley_count(&dense),
-                    "order {order}"
-                );
-                if fast.len() < dense.len() {
+                if agrees_with_dense(p, order) && p.degree() <= order + 1 {
                     sparse_used += 1;
                 }
             }
@@ -419,9 +432,9 @@ mod tests {
     }
 
     /// Where a derivative is quadratic or cubic on every piece (the acceleration of a
-    /// multi-mode pulse-convolution profile, position of degree 4 or 5), the pieces' ends and
-    /// turning points give a peak no lower than 64 points per piece and within their spacing of
-    /// it, and the same turning points, unshaped and shaped by ZV and ZVD.
+    /// multi-mode pulse-convolution profile, position of degree 4 or 5, unshaped and shaped),
+    /// the pieces' ends and turning points give the dense sampling's turning points and a
+    /// peak no lower than its.
     #[test]
     fn turning_points_give_the_dense_peaks_where_the_derivative_is_quadratic_or_cubic() {
         use crate::profile::{from_spec, ProfileSpec};
@@ -432,33 +445,14 @@ mod tests {
             .unwrap();
             from_spec(&spec).unwrap()
         };
-        let mut commands = vec![profile(&[1.2, 3.4, 7.9]), profile(&[1.2, 2.1, 3.4, 7.9])];
-        for f in [0.7, 2.3, 9.0] {
-            let mode = Mode::new(f, 0.05).unwrap();
-            for base in commands.clone().iter().take(2) {
-                commands.push(base.shaped(&zv(&mode).unwrap()).unwrap());
-                commands.push(base.shaped(&zvd(&mode).unwrap()).unwrap());
-            }
-        }
+        let commands = with_shaped(
+            vec![profile(&[1.2, 3.4, 7.9]), profile(&[1.2, 2.1, 3.4, 7.9])],
+            &[0.7, 2.3, 9.0],
+        );
         let mut turns_used = 0;
         for p in &commands {
             for order in 1..=3 {
-                let fast = sample_derivative(p, order);
-                let dense = sample_derivative_at(p, order, PER_PIECE);
-                let peak = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-                let (a, b) = (peak(&fast), peak(&dense));
-                assert!(
-                    a >= b * (1.0 - 1e-12) && a <= b * (1.0 + 1e-3),
-                    "degree {}, order {order}: {a} vs {b}",
-                    p.degree()
-                );
-                assert_eq!(
-                    peak_valley_count(&fast),
-                    peak_valley_count(&dense),
-                    "degree {}, order {order}",
-                    p.degree()
-                );
-                if (2..=3).contains(&(p.degree() - order)) {
+                if agrees_with_dense(p, order) && (2..=3).contains(&(p.degree() - order)) {
                     turns_used += 1;
                 }
             }
