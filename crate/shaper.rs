@@ -261,8 +261,10 @@ impl Shaper {
     }
 
     /// Time of the last impulse, in seconds: the delay the shaper adds to a move. For a
-    /// factored shaper the sum of the factors' durations (the first and last products are the
-    /// only ones at their times, so they are neither merged nor cancelled).
+    /// factored shaper the sum of the factors' durations: the last product's time, which its
+    /// expanded list keeps unless another product falls within the merge tolerance (10⁻¹² of
+    /// the span) of it — then the merged impulse keeps the earlier time, 10⁻¹² of the duration
+    /// sooner at most.
     pub fn duration(&self) -> f64 {
         if self.factored {
             return self.factored_duration();

@@ -36,8 +36,17 @@ fn check_guarantee(
 ) -> Result<(), TestCaseError> {
     let imps = pairs(shaper);
     let sum: f64 = imps.iter().map(|p| p.1).sum();
+    // What f64 impulse times can resolve: a time t is known to ε·t, a phase error of ω·ε·t per
+    // impulse, so V at ω is exact only to about ω·ε·T·Σ|A| (T the last impulse). Negligible for
+    // any real shaper (100 Hz over 1 s: ~1e-13); not for a 1e-9 Hz mode's ZV-D⁷, which spans
+    // 4·10⁹ s and must still cancel at 8 Hz (tests/prop_design.proptest-regressions: 6.9e-8 at
+    // opt-level 3, under 1e-8 at the test profile's 1 only by the luck of its roundings).
+    let t_last = imps.last().map_or(0.0, |p| p.0.abs());
+    let weight: f64 = imps.iter().map(|p| p.1.abs()).sum();
     let at_modes = |bound: f64| -> Result<(), TestCaseError> {
         for m in modes {
+            let resolution = 4.0 * m.omega_rad_s() * f64::EPSILON * t_last * weight;
+            let bound = bound + resolution;
             let v = v_eq11(&imps, m.frequency_hz(), m.damping());
             prop_assert!(
                 v <= bound,
