@@ -7,8 +7,8 @@
 //! command exactly where it is piecewise polynomial.
 
 use crate::command::Command;
-use crate::error::Result;
-use crate::piecewise::{Cursor, Piecewise};
+use crate::error::{finite, Result};
+use crate::piecewise::{taylor_shift, Knot, Piecewise, ORDER};
 use crate::plant::modal::ModalPlant;
 use crate::simulate::Trajectory;
 use serde::Serialize;
@@ -60,9 +60,19 @@ pub struct Metrics {
 /// Computes the metrics of `trajectory`, the response to `applied` (the command actually sent,
 /// shaped or not); distances, settling and delay refer to `reference` (the unshaped command).
 pub fn metrics(trajectory: &Trajectory, applied: &Command, reference: &Command) -> Result<Metrics> {
+    metrics_with(trajectory, &CommandFigures::of(applied)?, reference)
+}
+
+/// [`metrics`] with the applied command's own figures already known (`applied`: those of the
+/// command `trajectory` responds to).
+pub fn metrics_with(
+    trajectory: &Trajectory,
+    applied: &CommandFigures,
+    reference: &Command,
+) -> Result<Metrics> {
     let t = &trajectory.time;
     let y = &trajectory.endpoint;
-    let move_end = applied.end_time();
+    let move_end = applied.move_end;
     let ref_pw = reference.to_piecewise()?;
     let at_rest = ref_pw.ends_at_rest();
     let final_pos = ref_pw.final_state()[0];
@@ -123,10 +133,6 @@ pub fn metrics(trajectory: &Trajectory, applied: &Command, reference: &Command) 
         .filter(|(ti, _)| **ti <= move_end)
         .map(|(_, d)| d.abs())
         .fold(0.0, f64::max);
-    let (peak_acceleration, peak_jerk, count) = match applied {
-        Command::Piecewise(p) => command_peaks(p),
-        Command::Sampled(s) => sampled_peaks(s.values(), s.period()),
-    };
     Ok(Metrics {
         move_end,
         distance,
@@ -138,9 +144,9 @@ pub fn metrics(trajectory: &Trajectory, applied: &Command, reference: &Command) 
         rise_time,
         delay,
         peak_deflection,
-        peak_acceleration,
-        peak_jerk,
-        acceleration_peak_valley_count: count,
+        peak_acceleration: applied.peak_acceleration,
+        peak_jerk: applied.peak_jerk,
+        acceleration_peak_valley_count: applied.acceleration_peak_valley_count,
     })
 }
 
@@ -180,63 +186,227 @@ pub fn mode_residual_percent(plant: &ModalPlant, command: &Piecewise) -> Result<
     ))
 }
 
-/// Values of the `order`-th derivative of a piecewise command: 0 before it starts, each piece
-/// at [`PER_PIECE`] + 1 points, and its final value. Where that derivative is linear on every
-/// piece (`order` ≥ degree − 1: the acceleration of trapezoids and S-curves, shaped or not),
-/// each piece is monotone and only its two ends are sampled: the interior points could not
-/// change the peak |value| or the turning points [`peak_valley_count`] finds. Where it is
-/// constant on every piece (`order` ≥ degree: a trapezoid's acceleration), one value per piece:
-/// both ends would be the same number (the Taylor shift of order 0 adds nothing to it), and a
-/// repeated value changes neither the peak nor [`peak_valley_count`]. Where it is quadratic or
-/// cubic, [`sample_derivative_turns`]: the ends and the turning points of each piece.
-fn sample_derivative(p: &Piecewise, order: usize) -> Vec<f64> {
-    if p.degree() <= order {
-        let mut out = Vec::with_capacity(p.knots().len() + 1);
-        out.push(0.0);
-        let mut cursor = Cursor::new(p);
-        for k in p.knots() {
-            cursor.seek(k.time);
-            out.push(cursor.state_at(k.time)[order]);
-        }
-        return out;
-    }
-    if p.degree() <= order + 1 {
-        return sample_derivative_at(p, order, 1);
-    }
-    if p.degree() <= order + 3 {
-        return sample_derivative_turns(p, order);
-    }
-    sample_derivative_at(p, order, PER_PIECE)
+/// What [`metrics`] reads from the applied command itself: when it ends and its peaks. The
+/// page keeps these for a shaper and a command across edits of the plant, which change only
+/// the response.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CommandFigures {
+    /// When the command stops changing (its last knot).
+    pub move_end: f64,
+    /// Largest |acceleration| (`None` where the velocity jumps).
+    pub peak_acceleration: Option<f64>,
+    /// Largest |jerk| (`None` where the acceleration jumps).
+    pub peak_jerk: Option<f64>,
+    /// Turning points of the acceleration ([`peak_valley_count`]).
+    pub acceleration_peak_valley_count: usize,
 }
 
-/// [`sample_derivative`] where the derivative is quadratic or cubic on every piece (a
-/// multi-mode pulse-convolution profile's acceleration): each piece's two ends and the points
-/// inside it where the derivative turns (the roots of its own derivative, linear or quadratic:
-/// closed form). Between those it is monotone, so the peak |value| is exact (dense sampling
-/// only approaches it) and the turning points are the ones [`peak_valley_count`] would find.
-fn sample_derivative_turns(p: &Piecewise, order: usize) -> Vec<f64> {
-    let knots = p.knots();
-    let mut out = Vec::with_capacity(knots.len() * 4 + 2);
-    out.push(0.0);
-    let mut cursor = Cursor::new(p);
-    for (i, k) in knots.iter().enumerate() {
-        cursor.seek(k.time);
-        let s = cursor.state_at(k.time);
-        out.push(s[order]);
-        let Some(next) = knots.get(i + 1) else {
-            continue;
-        };
-        let h = next.time - k.time;
-        // g'(τ) = c₁ + c₂τ + c₃τ²/2 on the piece (c: the derivatives at its start).
-        let c = |j: usize| s.get(order + j).copied().unwrap_or(0.0);
-        let mut turns = stationary_points(c(1), c(2), 0.5 * c(3));
-        turns.retain(|&tau| tau > 0.0 && tau < h);
-        for tau in turns {
-            out.push(cursor.state_at(k.time + tau)[order]);
+impl CommandFigures {
+    /// The figures of `command`.
+    pub fn of(command: &Command) -> Result<Self> {
+        match command {
+            Command::Piecewise(p) => {
+                knot_figures(p.knots().iter().copied(), p.degree()).map(|(f, _)| f)
+            }
+            Command::Sampled(s) => {
+                let (peak_acceleration, peak_jerk, count) = sampled_peaks(s.values(), s.period());
+                Ok(CommandFigures {
+                    move_end: command.end_time(),
+                    peak_acceleration,
+                    peak_jerk,
+                    acceleration_peak_valley_count: count,
+                })
+            }
         }
-        out.push(cursor.state_at(next.time)[order]);
     }
-    out
+
+    /// The figures of `reference` shaped by `shaper`: those of `Command::Piecewise(reference
+    /// .shaped(shaper)?)`, the same numbers to the last bit, read from its knots as they are
+    /// merged (`Piecewise::shaped_knots`) instead of from the formed command where the
+    /// reference has few knots (a six-mode ZV-D³ shapes a trapezoid into 62 500 knots). Errors
+    /// as `shaped` does (too many knots, a non-finite product).
+    pub fn of_shaped(reference: &Piecewise, shaper: &crate::shaper::Shaper) -> Result<Self> {
+        let Some(knots) = reference.shaped_knots(shaper)? else {
+            return CommandFigures::of(&Command::Piecewise(reference.shaped(shaper)?));
+        };
+        let degree = reference.degree();
+        let (figures, seen) = knot_figures(knots.clone(), degree)?;
+        // The shaped degree is the reference's unless its highest jumps all cancel: then the
+        // walk is taken again at the degree the command has (as `shaped` would store it).
+        if seen < degree {
+            return knot_figures(knots, seen).map(|(f, _)| f);
+        }
+        Ok(figures)
+    }
+}
+
+/// The figures of a piecewise command given as its knots (sorted, merged) and a bound on its
+/// degree, and the degree the knots have (the highest order that jumps; 0 for none).
+fn knot_figures(
+    knots: impl Iterator<Item = Knot>,
+    degree: usize,
+) -> Result<(CommandFigures, usize)> {
+    let w = walk(knots, degree, &[2, 3], Sampling::ByDegree)?;
+    let max_abs = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let figures = CommandFigures {
+        move_end: w.end,
+        peak_acceleration: (!w.unbounded[0]).then(|| max_abs(&w.samples[0])),
+        peak_jerk: (!w.unbounded[1]).then(|| max_abs(&w.samples[1])),
+        acceleration_peak_valley_count: peak_valley_count(&w.samples[0]),
+    };
+    Ok((figures, w.degree))
+}
+
+/// Peaks of the `order`-th derivative of a piecewise command are read from its values at
+/// these points of each piece ([`sample`]): 0 before it starts, then per piece
+/// - where the derivative is constant on every piece (`order` ≥ degree: a trapezoid's
+///   acceleration), one value: both ends would be the same number, and a repeated value changes
+///   neither the peak nor [`peak_valley_count`];
+/// - where it is linear (`order` = degree − 1: the acceleration of S-curves, shaped or not),
+///   the two ends: each piece is monotone, so the interior could not change the peak |value|
+///   or the turning points;
+/// - where it is quadratic or cubic, the ends and the points inside where it turns (the roots
+///   of its own derivative, linear or quadratic: closed form); between those it is monotone, so
+///   the peak |value| is exact (dense sampling only approaches it) and the turning points are
+///   the ones [`peak_valley_count`] would find;
+/// - else [`PER_PIECE`] + 1 evenly spaced points; the last knot gives one value.
+#[derive(Clone, Copy)]
+enum Sampling {
+    /// The rule above, by degree.
+    ByDegree,
+    /// `n` + 1 evenly spaced points per piece whatever the degree (`n` ≥ 1).
+    #[cfg_attr(not(test), allow(dead_code))]
+    Dense(usize),
+}
+
+/// Samples of derivatives of a piecewise command walked knot by knot.
+struct Walked {
+    /// Per requested order, its samples.
+    samples: Vec<Vec<f64>>,
+    /// Per requested order, whether a lower derivative jumps somewhere (it is unbounded).
+    unbounded: Vec<bool>,
+    /// The last knot's time (0 for none).
+    end: f64,
+    /// The highest order that jumps (0 for no knots).
+    degree: usize,
+}
+
+/// Walks `knots` (sorted, merged, of degree at most `degree`) and samples the derivatives of
+/// `orders` by `sampling`, keeping the Taylor state at the last knot passed as `Cursor` does
+/// (the same arithmetic, so the same bits). Errors: a non-finite knot, as `Piecewise::new`.
+fn walk(
+    knots: impl Iterator<Item = Knot>,
+    degree: usize,
+    orders: &[usize],
+    sampling: Sampling,
+) -> Result<Walked> {
+    let mut w = Walked {
+        samples: orders.iter().map(|_| vec![0.0]).collect(),
+        unbounded: vec![false; orders.len()],
+        end: 0.0,
+        degree: 0,
+    };
+    let mut knots = knots;
+    let mut anchor = [0.0; ORDER];
+    let mut first = true;
+    let mut next = knots.next();
+    while let Some(k) = next {
+        next = knots.next();
+        if !k.time.is_finite() || k.jumps.iter().any(|j| !j.is_finite()) {
+            finite("command.time", k.time)?;
+            for j in k.jumps {
+                finite("command", j)?;
+            }
+        }
+        if let Some(top) = k.jumps.iter().rposition(|&j| j != 0.0) {
+            w.degree = w.degree.max(top);
+        }
+        for (u, &order) in w.unbounded.iter_mut().zip(orders) {
+            *u |= k.jumps[..order].iter().any(|&j| j != 0.0);
+        }
+        let mut s = if first {
+            [0.0; ORDER]
+        } else {
+            taylor_shift(&anchor, degree, k.time - w.end)
+        };
+        for (a, j) in s.iter_mut().zip(k.jumps) {
+            *a += j;
+        }
+        anchor = s;
+        first = false;
+        w.end = k.time;
+        let piece = Piece {
+            state: &anchor,
+            start: k.time,
+            end: next.as_ref().map(|n| n.time),
+            degree,
+        };
+        for (out, &order) in w.samples.iter_mut().zip(orders) {
+            piece.sample(order, sampling, out);
+        }
+    }
+    Ok(w)
+}
+
+/// One piece of a walked command: the Taylor state just after its knot at `start`, up to the
+/// next knot at `end` (`None` after the last).
+struct Piece<'a> {
+    state: &'a [f64; ORDER],
+    start: f64,
+    end: Option<f64>,
+    degree: usize,
+}
+
+impl Piece<'_> {
+    /// The `order`-th derivative at `t` in the piece.
+    fn at(&self, t: f64, order: usize) -> f64 {
+        taylor_shift(self.state, self.degree, t - self.start)[order]
+    }
+
+    /// Pushes the samples of the `order`-th derivative on this piece ([`Sampling`]).
+    fn sample(&self, order: usize, sampling: Sampling, out: &mut Vec<f64>) {
+        let per_piece = match sampling {
+            Sampling::Dense(n) => n,
+            Sampling::ByDegree if self.degree <= order => {
+                // The Taylor shift by 0 of the state's highest entry, or 0 above it.
+                out.push(
+                    self.state
+                        .get(order)
+                        .filter(|_| order == self.degree)
+                        .map_or(0.0, |&v| v),
+                );
+                return;
+            }
+            Sampling::ByDegree if self.degree <= order + 1 => 1,
+            Sampling::ByDegree if self.degree <= order + 3 => {
+                out.push(self.at(self.start, order));
+                let Some(end) = self.end else {
+                    return;
+                };
+                // g'(τ) = c₁ + c₂τ + c₃τ²/2 on the piece (c: the derivatives at its start).
+                let s = taylor_shift(self.state, self.degree, 0.0);
+                let c = |j: usize| s.get(order + j).copied().unwrap_or(0.0);
+                let h = end - self.start;
+                let mut turns = stationary_points(c(1), c(2), 0.5 * c(3));
+                turns.retain(|&tau| tau > 0.0 && tau < h);
+                for tau in turns {
+                    out.push(self.at(self.start + tau, order));
+                }
+                out.push(self.at(end, order));
+                return;
+            }
+            Sampling::ByDegree => PER_PIECE,
+        };
+        match self.end {
+            Some(end) => {
+                for j in 0..=per_piece {
+                    let t = self.start + (end - self.start) * j as f64 / per_piece as f64;
+                    out.push(self.at(t, order));
+                }
+            }
+            None => out.push(self.at(self.start, order)),
+        }
+    }
 }
 
 /// The real roots of a + bτ + cτ², in increasing order (none for a constant).
@@ -259,40 +429,12 @@ fn stationary_points(a: f64, b: f64, c: f64) -> Vec<f64> {
     r
 }
 
-/// [`sample_derivative`] with `per_piece` + 1 points per piece (`per_piece` ≥ 1).
-fn sample_derivative_at(p: &Piecewise, order: usize, per_piece: usize) -> Vec<f64> {
-    let knots = p.knots();
-    let mut out = Vec::with_capacity(knots.len() * (per_piece + 1) + 2);
-    out.push(0.0);
-    let mut cursor = Cursor::new(p);
-    for (i, k) in knots.iter().enumerate() {
-        cursor.seek(k.time);
-        match knots.get(i + 1) {
-            Some(next) => {
-                for j in 0..=per_piece {
-                    let t = k.time + (next.time - k.time) * j as f64 / per_piece as f64;
-                    out.push(cursor.state_at(t)[order]);
-                }
-            }
-            None => out.push(cursor.state_at(k.time)[order]),
-        }
-    }
-    out
-}
-
-/// Peak acceleration, peak jerk (None where unbounded) and acceleration peak-valley count of a
-/// piecewise command.
-fn command_peaks(p: &Piecewise) -> (Option<f64>, Option<f64>, usize) {
-    let jumps_below = |order: usize| {
-        p.knots()
-            .iter()
-            .any(|k| k.jumps.iter().take(order).any(|&j| j != 0.0))
-    };
-    let acc = sample_derivative(p, 2);
-    let max_abs = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let peak_acc = (!jumps_below(2)).then(|| max_abs(&acc));
-    let peak_jerk = (!jumps_below(3)).then(|| max_abs(&sample_derivative(p, 3)));
-    (peak_acc, peak_jerk, peak_valley_count(&acc))
+/// The samples of the `order`-th derivative of `p` by `sampling` (tests: the rule against
+/// dense sampling).
+#[cfg(test)]
+fn sample_derivative(p: &Piecewise, order: usize, sampling: Sampling) -> Vec<f64> {
+    let w = walk(p.knots().iter().copied(), p.degree(), &[order], sampling).unwrap();
+    w.samples.into_iter().next().unwrap()
 }
 
 /// Peaks from finite differences of a sampled command.
@@ -363,10 +505,12 @@ pub fn peak_valley_count(x: &[f64]) -> usize {
 
 #[cfg(test)]
 mod tests {
-    use super::{peak_valley_count, sample_derivative, sample_derivative_at, PER_PIECE};
+    use super::{peak_valley_count, sample_derivative, CommandFigures, Sampling, PER_PIECE};
+    use crate::command::Command;
     use crate::command::{s_curve, trapezoid};
     use crate::design::zero_vibration::{zv, zvd};
     use crate::mode::Mode;
+    use crate::piecewise::Cursor;
     use crate::piecewise::Piecewise;
 
     /// `bases`, and each shaped by ZV and ZVD at every frequency of `freqs` (ζ 0.05):
@@ -383,14 +527,40 @@ mod tests {
         out
     }
 
+    /// The `order`-th derivative of `p` at 64 points per piece, read by the crate's `Cursor`
+    /// (the reader plants and spectra use), not by the metrics' own walk.
+    fn dense_by_cursor(p: &Piecewise, order: usize) -> Vec<f64> {
+        let knots = p.knots();
+        let mut out = vec![0.0];
+        let mut cursor = Cursor::new(p);
+        for (i, k) in knots.iter().enumerate() {
+            cursor.seek(k.time);
+            match knots.get(i + 1) {
+                Some(next) => {
+                    for j in 0..=PER_PIECE {
+                        let t = k.time + (next.time - k.time) * j as f64 / PER_PIECE as f64;
+                        out.push(cursor.state_at(t)[order]);
+                    }
+                }
+                None => out.push(cursor.state_at(k.time)[order]),
+            }
+        }
+        out
+    }
+
     /// The `order`-th derivative of `p` sampled by [`sample_derivative`] against 64 points per
     /// piece (an independent computation): the same turning points; the same peak where only
     /// the pieces' ends are taken (a linear derivative), else no lower and within 1e-3 of it
     /// (the turning points are exact, dense sampling only approaches them). Returns whether
     /// the fast path took fewer points.
     fn agrees_with_dense(p: &Piecewise, order: usize) -> bool {
-        let fast = sample_derivative(p, order);
-        let dense = sample_derivative_at(p, order, PER_PIECE);
+        let fast = sample_derivative(p, order, Sampling::ByDegree);
+        let dense = dense_by_cursor(p, order);
+        assert_eq!(
+            dense,
+            sample_derivative(p, order, Sampling::Dense(PER_PIECE)),
+            "the walk's dense sampling is the cursor's"
+        );
         let peak = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         let (a, b) = (peak(&fast), peak(&dense));
         let what = format!("degree {}, order {order}: {a} vs {b}", p.degree());
@@ -461,6 +631,95 @@ mod tests {
             turns_used >= 20,
             "the turning-point path ran {turns_used} times"
         );
+    }
+
+    /// A command's figures read from its knots as they are merged (`of_shaped`) are those of
+    /// the formed shaped command, to the last bit: trapezoids, S-curves and profiles (degree 2
+    /// to 5) shaped by ZV, ZVD and factored ZV-D³ over up to six modes (a 62 500-knot command),
+    /// a reference of more than 16 knots (formed by a sort), and two impulses that cancel a
+    /// knot of the trapezoid (merged to nothing). Too many knots: the same error.
+    #[test]
+    fn figures_of_a_shaped_command_are_the_formed_commands_to_the_bit() {
+        use crate::design::{design, DesignRequest, ShaperSpec};
+        use crate::mode::ModeSpec;
+        use crate::profile::{from_spec, ProfileSpec};
+        use crate::shaper::{Impulse, Shaper};
+        let profile: ProfileSpec = serde_json::from_str(
+            r#"{"shape":"multiMode","modesHz":[1.2,3.4,7.9],"distance":1,"duration":2}"#,
+        )
+        .unwrap();
+        let references = [
+            trapezoid(1.0, 0.75, 8.0, 0.0).unwrap(),
+            s_curve(1.0, 0.8, 2.0, 20.0, 0.0).unwrap(),
+            from_spec(&profile).unwrap(),
+            // Already shaped twice: 36 knots.
+            trapezoid(1.0, 0.75, 8.0, 0.0)
+                .unwrap()
+                .shaped(&zvd(&Mode::new(5.0, 0.1).unwrap()).unwrap())
+                .unwrap()
+                .shaped(&zvd(&Mode::new(9.0, 0.1).unwrap()).unwrap())
+                .unwrap(),
+        ];
+        assert!(
+            references[3].knots().len() > 16,
+            "a reference formed by the sort"
+        );
+        let zvd3 = |modes: &[f64]| {
+            let modes = modes
+                .iter()
+                .map(|&f| ModeSpec {
+                    frequency_hz: f,
+                    damping: 0.02,
+                })
+                .collect();
+            let shaper = ShaperSpec::Zvdn { derivatives: 3 };
+            design(&DesignRequest { modes, shaper }).unwrap()
+        };
+        let mode = Mode::new(1.2, 0.02).unwrap();
+        // The trapezoid accelerates for 0.09375 s: impulses that far apart, of equal size,
+        // cancel its jump there (a knot merged to nothing and dropped).
+        let cancelling = Shaper::new(vec![
+            Impulse {
+                time: 0.0,
+                amplitude: 0.5,
+            },
+            Impulse {
+                time: 0.09375,
+                amplitude: 0.5,
+            },
+        ])
+        .unwrap();
+        let shapers = [
+            zv(&mode).unwrap(),
+            zvd(&mode).unwrap(),
+            zvd3(&[1.2, 3.4, 7.9]),
+            zvd3(&[1.2, 3.4, 7.9, 13.0, 21.0, 34.0]),
+            cancelling,
+        ];
+        assert_eq!(shapers[3].len(), 15_625);
+        assert!(
+            references[0].shaped(&shapers[4]).unwrap().knots().len() < 8,
+            "a knot of the trapezoid shaped by the two impulses cancels"
+        );
+        let mut checked = 0;
+        for r in &references {
+            for s in &shapers {
+                let formed = match r.shaped(s) {
+                    Ok(p) => p,
+                    Err(e) => {
+                        assert_eq!(CommandFigures::of_shaped(r, s).unwrap_err(), e);
+                        continue;
+                    }
+                };
+                let want = CommandFigures::of(&Command::Piecewise(formed)).unwrap();
+                let got = CommandFigures::of_shaped(r, s).unwrap();
+                assert_eq!(format!("{got:?}"), format!("{want:?}"));
+                checked += 1;
+            }
+        }
+        assert!(checked >= 18, "{checked} compared");
+        let too_many = shapers[3].len() * references[3].knots().len();
+        assert!(too_many > crate::piecewise::MAX_KNOTS, "one error compared");
     }
 
     /// The roots of a + bτ + cτ², against the closed form.

@@ -58,30 +58,23 @@ impl Piecewise {
             });
         }
         for k in &knots {
-            finite("command.time", k.time)?;
-            for j in k.jumps {
-                finite("command", j)?;
+            // Checked inline, the error built only for a bad value (a shaped 6-mode command
+            // has 62 500 knots of 10 numbers).
+            if !k.time.is_finite() || k.jumps.iter().any(|j| !j.is_finite()) {
+                finite("command.time", k.time)?;
+                for j in k.jumps {
+                    finite("command", j)?;
+                }
             }
         }
         let mut sorted = knots;
         crate::sort::sort_by(&mut sorted, |a, b| a.time.total_cmp(&b.time));
         let span = match (sorted.first(), sorted.last()) {
-            (Some(a), Some(b)) => (b.time - a.time).abs().max(a.time.abs()).max(b.time.abs()),
+            (Some(a), Some(b)) => merge_span(a.time, b.time),
             _ => 0.0,
         };
-        let tol = (KNOT_MERGE * span).max(1e-15);
-        let mut merged: Vec<Knot> = Vec::with_capacity(sorted.len());
-        for k in sorted {
-            match merged.last_mut() {
-                Some(last) if k.time - last.time <= tol => {
-                    for (a, b) in last.jumps.iter_mut().zip(k.jumps) {
-                        *a += b;
-                    }
-                }
-                _ => merged.push(k),
-            }
-        }
-        merged.retain(|k| k.jumps.iter().any(|&j| j != 0.0));
+        let mut merged = Vec::with_capacity(sorted.len());
+        merged.extend(MergedKnots::new(sorted.into_iter(), span));
         let degree = merged
             .iter()
             .filter_map(|k| k.jumps.iter().rposition(|&j| j != 0.0))
@@ -161,7 +154,7 @@ impl Piecewise {
         // command to the last bit, and `new` finds it sorted (no index sort, no permutation
         // of the 80-byte knots: 62 500 for a 6-mode ZV-D³).
         if self.knots.len() <= MERGED_RUNS {
-            return Piecewise::new(self.shaped_runs_merged(shaper.impulses(), n));
+            return Piecewise::new(ShapedRuns::new(&self.knots, shaper.impulses()).collect());
         }
         let mut knots = Vec::with_capacity(n);
         for k in &self.knots {
@@ -179,33 +172,34 @@ impl Piecewise {
         Piecewise::new(knots)
     }
 
-    /// The `n` knots of [`Piecewise::shaped`] in time order: the runs (one per knot, shifted by
-    /// every impulse, each sorted since addition is monotone) merged, a tie going to the
-    /// earlier run and, within a run, to the earlier impulse.
-    fn shaped_runs_merged(&self, impulses: &[crate::shaper::Impulse], n: usize) -> Vec<Knot> {
-        let mut heads = vec![0_usize; self.knots.len()];
-        let mut knots = Vec::with_capacity(n);
-        loop {
-            let mut best: Option<(usize, f64)> = None;
-            for (r, k) in self.knots.iter().enumerate() {
-                if let Some(imp) = impulses.get(heads[r]) {
-                    let t = k.time + imp.time;
-                    if best.is_none_or(|(_, b)| t.total_cmp(&b).is_lt()) {
-                        best = Some((r, t));
-                    }
-                }
-            }
-            let Some((r, time)) = best else {
-                return knots;
-            };
-            let amplitude = impulses[heads[r]].amplitude;
-            heads[r] += 1;
-            let mut jumps = self.knots[r].jumps;
-            for j in &mut jumps {
-                *j *= amplitude;
-            }
-            knots.push(Knot { time, jumps });
+    /// The knots of [`Piecewise::shaped`] one by one, in time order, without forming the
+    /// command: the knots `shaped(shaper)` stores, merged the same way (what walks the shaped
+    /// command once, like its peaks, need not hold 62 500 knots of 80 bytes). `None` for a
+    /// command of more than 16 knots (shaped by a sort). The shaped command's degree is this
+    /// one's unless its highest jumps cancel exactly. The knots are not checked finite: their
+    /// reader checks them (an infinite product stays infinite, or becomes NaN when merged).
+    pub(crate) fn shaped_knots<'a>(
+        &'a self,
+        shaper: &'a Shaper,
+    ) -> Result<Option<MergedKnots<ShapedRuns<'a>>>> {
+        let impulses = shaper.impulses();
+        let n = self.knots.len().saturating_mul(impulses.len());
+        if n > MAX_KNOTS {
+            return Err(Error::TooLarge {
+                field: "command".into(),
+                value: n as f64,
+                limit: MAX_KNOTS as f64,
+            });
         }
+        if self.knots.len() > MERGED_RUNS {
+            return Ok(None);
+        }
+        let runs = ShapedRuns::new(&self.knots, impulses);
+        let span = match (runs.first_time(), runs.last_time()) {
+            (Some(a), Some(b)) => merge_span(a, b),
+            _ => 0.0,
+        };
+        Ok(Some(MergedKnots::new(runs, span)))
     }
 
     /// The derivative of the command (its jumps moved one order down; the position jumps
@@ -249,6 +243,127 @@ impl Piecewise {
                 })
                 .collect(),
         )
+    }
+}
+
+/// The span [`KNOT_MERGE`] is relative to, for knots from `first` to `last` (sorted).
+fn merge_span(first: f64, last: f64) -> f64 {
+    (last - first).abs().max(first.abs()).max(last.abs())
+}
+
+/// The knots of a command shaped by an impulse sequence, in time order, not yet merged: one run
+/// per knot of the command (shifted by every impulse, sorted since addition is monotone)
+/// merged, a tie going to the earlier run and, within a run, to the earlier impulse — the
+/// order a stable sort gives the runs' concatenation, so the same command to the last bit.
+#[derive(Clone)]
+pub(crate) struct ShapedRuns<'a> {
+    runs: &'a [Knot],
+    impulses: &'a [crate::shaper::Impulse],
+    heads: Vec<usize>,
+    left: usize,
+}
+
+impl<'a> ShapedRuns<'a> {
+    fn new(runs: &'a [Knot], impulses: &'a [crate::shaper::Impulse]) -> Self {
+        ShapedRuns {
+            runs,
+            impulses,
+            heads: vec![0; runs.len()],
+            left: runs.len() * impulses.len(),
+        }
+    }
+
+    /// The earliest knot's time (the impulses are sorted by time).
+    fn first_time(&self) -> Option<f64> {
+        let t0 = self.impulses.first()?.time;
+        self.runs.iter().map(|k| k.time + t0).reduce(f64::min)
+    }
+
+    /// The latest knot's time.
+    fn last_time(&self) -> Option<f64> {
+        let t1 = self.impulses.last()?.time;
+        self.runs.iter().map(|k| k.time + t1).reduce(f64::max)
+    }
+}
+
+impl Iterator for ShapedRuns<'_> {
+    type Item = Knot;
+
+    fn next(&mut self) -> Option<Knot> {
+        let mut best: Option<(usize, f64)> = None;
+        for (r, k) in self.runs.iter().enumerate() {
+            if let Some(imp) = self.impulses.get(self.heads[r]) {
+                let t = k.time + imp.time;
+                if best.is_none_or(|(_, b)| t.total_cmp(&b).is_lt()) {
+                    best = Some((r, t));
+                }
+            }
+        }
+        let (r, time) = best?;
+        let amplitude = self.impulses[self.heads[r]].amplitude;
+        self.heads[r] += 1;
+        self.left -= 1;
+        let mut jumps = self.runs[r].jumps;
+        for j in &mut jumps {
+            *j *= amplitude;
+        }
+        Some(Knot { time, jumps })
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.left, Some(self.left))
+    }
+}
+
+/// Knots in time order with the knots closer than [`KNOT_MERGE`] × `span` (floor 1e-15 s)
+/// merged into the first of them (jumps summed in order) and the knots whose jumps are all
+/// zero dropped: what a [`Piecewise`] keeps.
+#[derive(Clone)]
+pub(crate) struct MergedKnots<I> {
+    sorted: I,
+    tol: f64,
+    pending: Option<Knot>,
+}
+
+impl<I: Iterator<Item = Knot>> MergedKnots<I> {
+    fn new(mut sorted: I, span: f64) -> Self {
+        let pending = sorted.next();
+        MergedKnots {
+            sorted,
+            tol: (KNOT_MERGE * span).max(1e-15),
+            pending,
+        }
+    }
+}
+
+impl<I: Iterator<Item = Knot>> Iterator for MergedKnots<I> {
+    type Item = Knot;
+
+    fn next(&mut self) -> Option<Knot> {
+        loop {
+            let mut out = self.pending.take()?;
+            loop {
+                match self.sorted.next() {
+                    Some(k) if k.time - out.time <= self.tol => {
+                        for (a, b) in out.jumps.iter_mut().zip(k.jumps) {
+                            *a += b;
+                        }
+                    }
+                    next => {
+                        self.pending = next;
+                        break;
+                    }
+                }
+            }
+            if out.jumps.iter().any(|&j| j != 0.0) {
+                return Some(out);
+            }
+        }
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let (_, hi) = self.sorted.size_hint();
+        (0, hi.map(|h| h + usize::from(self.pending.is_some())))
     }
 }
 

@@ -6,16 +6,17 @@ use super::state::Frame;
 use crate::command::Command;
 use crate::design::ShaperSpec;
 use crate::error::Error;
-use crate::metrics::Metrics;
+use crate::metrics::{CommandFigures, Metrics};
 use crate::mode::Mode;
 use crate::piecewise::{Knot, Piecewise, ORDER};
 use crate::shaper::Shaper;
 use crate::simulate::Trajectory;
+use std::cell::RefCell;
 
 /// The responses of a frame.
 pub(super) struct Simulation {
-    /// The command each compared shaper sends.
-    pub commands: Vec<Command>,
+    /// The command each compared shaper sends, where it is formed ([`formed`]).
+    pub commands: Vec<Option<Command>>,
     /// The response to the reference command, and its metrics.
     pub unshaped: Trajectory,
     pub unshaped_metrics: Metrics,
@@ -35,16 +36,18 @@ pub(super) fn simulate(frame: &Frame, analysis: &mut Analysis) -> Result<Simulat
         .specs
         .iter()
         .zip(&analysis.shapers)
-        .map(|(spec, shaper)| shaped_command(spec, shaper, command))
+        .map(|(spec, shaper)| formed(spec, command).then(|| shaped_command(spec, shaper, command)))
+        .map(Option::transpose)
         .collect::<Result<Vec<_>, _>>()?;
+    let figures = command_figures(frame, analysis, &commands)?;
     let plant_modes = frame.plant.modes()?;
     let slowest = plant_modes
         .iter()
         .map(Mode::damped_period_s)
         .fold(0.0_f64, f64::max);
-    let end = commands
+    let end = figures
         .iter()
-        .map(Command::end_time)
+        .map(|f| f.move_end)
         .fold(command.end_time(), f64::max);
     // Checked in range when the frame was read.
     let duration = match frame.view.duration {
@@ -58,27 +61,38 @@ pub(super) fn simulate(frame: &Frame, analysis: &mut Analysis) -> Result<Simulat
     };
     let unshaped = sim(command)?;
     let unshaped_metrics =
-        move_metrics(&unshaped, command, command).map_err(|e| e.within("view"))?;
+        crate::metrics::metrics(&unshaped, command, command).map_err(|e| e.within("view"))?;
     let mut shaped = Vec::with_capacity(commands.len());
     for (k, c) in commands.iter().enumerate() {
         // The reference shaped by a shaper: simulated from the shaper's convolution factors
         // (the same response to rounding, without a knot per impulse of the expanded shaper).
-        let t = if own_move(&frame.specs[k]) || !matches!(command, Command::Piecewise(_)) {
-            sim(c)?
-        } else {
-            crate::simulate::simulate_shaped(
+        let t = match c {
+            Some(c) => sim(c)?,
+            None => crate::simulate::simulate_shaped(
                 &frame.plant,
                 command,
                 &analysis.shapers[k],
                 sample_period,
                 duration,
             )
-            .map_err(|e| e.within("view"))?
+            .map_err(|e| e.within("view"))?,
         };
-        let force = c != command && analysis.shapers[k].centroid_delay().is_none();
-        let reference = if force { c } else { command };
-        analysis.results[k].simulation =
-            Some(move_metrics(&t, c, reference).map_err(|e| e.within("view"))?);
+        // A shaper whose amplitudes sum to 0 (the force-profile moves, or such a custom
+        // shaper) moves to somewhere else than the reference: its own command is its reference.
+        let zero_sum = analysis.shapers[k].centroid_delay().is_none();
+        let own = match c {
+            Some(c) if zero_sum => Some(c.clone()),
+            None if zero_sum => Some(shaped_command(
+                &frame.specs[k],
+                &analysis.shapers[k],
+                command,
+            )?),
+            _ => None,
+        };
+        analysis.results[k].simulation = Some(
+            crate::metrics::metrics_with(&t, &figures[k], own.as_ref().unwrap_or(command))
+                .map_err(|e| e.within("view"))?,
+        );
         shaped.push(t);
     }
     Ok(Simulation {
@@ -92,6 +106,56 @@ pub(super) fn simulate(frame: &Frame, analysis: &mut Analysis) -> Result<Simulat
     })
 }
 
+/// Whether the command a shaper sends is formed: for the families that make their own move,
+/// and for a sampled reference (shaped by the streaming filter). A piecewise reference shaped
+/// by a shaper is not: its response comes from the shaper's factors, its figures from its
+/// knots as they are merged, its spectrum from the product |S(f)|·|U(f)|.
+fn formed(spec: &ShaperSpec, command: &Command) -> bool {
+    own_move(spec) || !matches!(command, Command::Piecewise(_))
+}
+
+thread_local! {
+    /// The shaped commands' own figures (end, peaks) of the last frame, with the analysis
+    /// ([`Analysis::generation`]) and the reference command they are of: an edit of the plant,
+    /// the mismatch or the window changes the responses only, and a six-mode ZV-D³'s
+    /// trapezoid has 62 500 knots to walk.
+    static FIGURES: RefCell<Option<(u64, Command, Vec<CommandFigures>)>> = const { RefCell::new(None) };
+}
+
+/// The figures of every shaper's command, from [`FIGURES`] when the designs and the reference
+/// are the last frame's.
+fn command_figures(
+    frame: &Frame,
+    analysis: &Analysis,
+    commands: &[Option<Command>],
+) -> Result<Vec<CommandFigures>, Error> {
+    let key = analysis.generation;
+    let cached = FIGURES.with_borrow(|c| {
+        c.as_ref()
+            .filter(|(g, reference, _)| *g == key && *reference == frame.command)
+            .map(|(_, _, f)| f.clone())
+    });
+    if let Some(f) = cached {
+        return Ok(f);
+    }
+    let figures = commands
+        .iter()
+        .zip(&analysis.shapers)
+        .map(|(c, shaper)| {
+            let f = match (c, &frame.command) {
+                (Some(c), _) => CommandFigures::of(c),
+                (None, Command::Piecewise(p)) => CommandFigures::of_shaped(p, shaper),
+                (None, reference) => reference
+                    .shaped(shaper)
+                    .and_then(|c| CommandFigures::of(&c)),
+            };
+            f.map_err(|e| e.within("view.command"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    FIGURES.with_borrow_mut(|c| *c = Some((key, frame.command.clone(), figures.clone())));
+    Ok(figures)
+}
+
 /// |U(f)| of the reference command, and of each shaped command on the same grid.
 pub(super) type Spectra = (crate::spectrum::Spectrum, Vec<Vec<f64>>);
 
@@ -100,7 +164,7 @@ pub(super) type Spectra = (crate::spectrum::Spectrum, Vec<Vec<f64>>);
 pub(super) fn command_spectra(
     frame: &Frame,
     analysis: &Analysis,
-    commands: &[Command],
+    commands: &[Option<Command>],
 ) -> Result<Option<Spectra>, Error> {
     let Some(impulse_spectra) = &analysis.impulse_spectra else {
         return Ok(None);
@@ -116,13 +180,18 @@ pub(super) fn command_spectra(
     let shaped = impulse_spectra
         .iter()
         .zip(commands)
-        .map(|(s, c)| match s {
-            Some(s) if matches!(frame.command, Command::Piecewise(_)) => Ok(s
+        .enumerate()
+        .map(|(k, (s, c))| match (s, c) {
+            (Some(s), _) if matches!(frame.command, Command::Piecewise(_)) => Ok(s
                 .iter()
                 .zip(&unshaped.magnitude)
                 .map(|(a, b)| a * b)
                 .collect()),
-            _ => one(c).map(|s| s.magnitude),
+            (_, Some(c)) => one(c).map(|s| s.magnitude),
+            // Not formed for the simulation: formed here.
+            (_, None) => shaped_command(&frame.specs[k], &analysis.shapers[k], &frame.command)
+                .and_then(|c| one(&c))
+                .map(|s| s.magnitude),
         })
         .collect::<Result<Vec<Vec<f64>>, Error>>()?;
     Ok(Some((unshaped, shaped)))
@@ -159,14 +228,4 @@ fn shaped_command(spec: &ShaperSpec, shaper: &Shaper, command: &Command) -> Resu
         }
         None => command.shaped(shaper).map_err(|e| e.within("view.command")),
     }
-}
-
-/// Metrics of a simulated move. The per-mode residuals (`modeResidualPercent`) are left out:
-/// the page does not show them and they cost a second simulation per move.
-fn move_metrics(
-    traj: &Trajectory,
-    applied: &Command,
-    reference: &Command,
-) -> Result<Metrics, Error> {
-    crate::metrics::metrics(traj, applied, reference)
 }
