@@ -68,7 +68,7 @@ impl Piecewise {
             }
         }
         let mut sorted = knots;
-        crate::sort::sort_by(&mut sorted, |a, b| a.time.total_cmp(&b.time));
+        crate::sort::sort_by_f64_key(&mut sorted, |k| k.time);
         let span = match (sorted.first(), sorted.last()) {
             (Some(a), Some(b)) => merge_span(a.time, b.time),
             _ => 0.0,

@@ -91,7 +91,7 @@ const MERGE_TOLERANCE: f64 = 1e-12;
 /// beyond [`MAX_AMPLITUDE`], or amplitudes that cancel to zero.
 fn merge(impulses: Vec<Impulse>) -> Result<Vec<Impulse>> {
     let mut sorted = impulses;
-    crate::sort::sort_by(&mut sorted, |a, b| a.time.total_cmp(&b.time));
+    crate::sort::sort_by_f64_key(&mut sorted, |k| k.time);
     let t0 = sorted[0].time;
     let span = sorted[sorted.len() - 1].time - t0;
     let tol = MERGE_TOLERANCE * span.max(f64::MIN_POSITIVE);
@@ -521,7 +521,7 @@ fn expand(factors: &[Vec<Impulse>]) -> Vec<Impulse> {
         out = next;
     }
     merge(out.clone()).unwrap_or_else(|_| {
-        crate::sort::sort_by(&mut out, |a, b| a.time.total_cmp(&b.time));
+        crate::sort::sort_by_f64_key(&mut out, |k| k.time);
         out
     })
 }

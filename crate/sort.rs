@@ -16,7 +16,60 @@ pub(crate) fn sort_indices(indices: &mut [usize], cmp: &dyn Fn(usize, usize) -> 
 pub(crate) fn sort_by<T>(v: &mut [T], cmp: impl Fn(&T, &T) -> Ordering) {
     let mut order: Vec<usize> = (0..v.len()).collect();
     sort_indices(&mut order, &|a, b| cmp(&v[a], &v[b]));
-    // Apply the permutation (new[i] = old[order[i]]) cycle by cycle with swaps.
+    permute(v, &order);
+}
+
+/// Sorts `v` stably by an `f64` key in [`f64::total_cmp`]'s order, as
+/// `sort_by(v, |a, b| key(a).total_cmp(&key(b)))` does, by a least-significant-digit radix
+/// sort of the keys' bits (8 passes of a byte, a pass skipped where every key has the same
+/// byte; none where `v` is already sorted): the impulse times of a 6-mode convolution (15 625)
+/// and the knots of a command shaped by it, in time order, without a comparison sort.
+pub(crate) fn sort_by_f64_key<T>(v: &mut [T], key: impl Fn(&T) -> f64) {
+    let n = v.len();
+    if n < 64 || u32::try_from(n).is_err() {
+        return sort_by(v, |a, b| key(a).total_cmp(&key(b)));
+    }
+    // total_cmp's order as unsigned integers: negative numbers (sign set) reversed, after them
+    // the positive ones.
+    let bits = |x: f64| {
+        let b = x.to_bits();
+        if b >> 63 == 1 {
+            !b
+        } else {
+            b | 1 << 63
+        }
+    };
+    let keys: Vec<u64> = v.iter().map(|x| bits(key(x))).collect();
+    if keys.windows(2).all(|w| w[0] <= w[1]) {
+        return;
+    }
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    let mut next = vec![0_u32; n];
+    for shift in (0..64).step_by(8) {
+        let byte = |i: u32| ((keys[i as usize] >> shift) & 0xff) as usize;
+        let mut start = [0_usize; 257];
+        for &i in &order {
+            start[byte(i) + 1] += 1;
+        }
+        if start.contains(&n) {
+            continue;
+        }
+        for b in 1..257 {
+            start[b] += start[b - 1];
+        }
+        for &i in &order {
+            let b = byte(i);
+            next[start[b]] = i;
+            start[b] += 1;
+        }
+        std::mem::swap(&mut order, &mut next);
+    }
+    let order: Vec<usize> = order.into_iter().map(|i| i as usize).collect();
+    permute(v, &order);
+}
+
+/// Applies the permutation `order` to `v` (new[i] = old[order[i]]) cycle by cycle with swaps.
+fn permute<T>(v: &mut [T], order: &[usize]) {
     let mut done = vec![false; v.len()];
     for start in 0..v.len() {
         let mut at = start;
@@ -54,5 +107,56 @@ mod tests {
             sort_by(&mut b, |x, y| x.0.cmp(&y.0));
             assert_eq!(a, b);
         }
+    }
+    /// The radix sort by an f64 key gives `sort_by`'s stable order by `total_cmp`: keys with
+    /// many ties, both zeros, negatives, infinities and NaNs of both signs, sorted and reversed
+    /// inputs, sizes around the radix path's threshold.
+    #[test]
+    fn radix_by_f64_key_is_the_stable_sort_by_total_cmp() {
+        let mut seed = 99u64;
+        let mut rand = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            seed >> 11
+        };
+        let specials = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            -f64::NAN,
+            1e-300,
+            5e-324,
+        ];
+        let mut radix_runs = 0;
+        for n in [0, 1, 63, 64, 65, 200, 1000, 15_625] {
+            for kind in 0..4 {
+                let v: Vec<(f64, usize)> = (0..n)
+                    .map(|i| {
+                        let r = rand();
+                        let x = match kind {
+                            0 => (r % 17) as f64 * 0.25,
+                            1 => specials[(r % specials.len() as u64) as usize],
+                            2 => f64::from_bits(r) * if r & 1 == 0 { 1.0 } else { -1.0 },
+                            _ => -(i as f64),
+                        };
+                        (x, i)
+                    })
+                    .collect();
+                let mut want = v.clone();
+                sort_by(&mut want, |a, b| a.0.total_cmp(&b.0));
+                let mut got = v.clone();
+                sort_by_f64_key(&mut got, |x| x.0);
+                let bits =
+                    |w: &[(f64, usize)]| w.iter().map(|x| (x.0.to_bits(), x.1)).collect::<Vec<_>>();
+                assert_eq!(bits(&got), bits(&want), "n {n}, kind {kind}");
+                radix_runs += usize::from(n >= 64);
+            }
+        }
+        assert!(radix_runs >= 20);
     }
 }
