@@ -288,6 +288,32 @@ fn negative_amplitudes_give_a_shorter_si() {
     assert!(max_v(&negative, 0.75, 1.25, 0.0, 2001) <= 0.05 * (1.0 + 1e-9));
 }
 
+/// An amplitudeMax far above anything a shaper summing to 1 can reach binds nothing: the same
+/// shaper as a bound just above that reach, every amplitude within amplitudeMin, Σ A = 1. Found
+/// by the 10⁶-case property run (2026-12-06): with `amplitudeMax: 1e12` the design program's
+/// scale was the bound's, its Σ A came out 4e-5 short, and the rescaled amplitudes fell 6e-7
+/// below amplitudeMin, which a bound tolerance taken relative to the 10¹² range let through.
+#[wasm_bindgen_test(unsupported = test)]
+fn a_huge_amplitude_max_binds_nothing() {
+    let amplitude_min = -0.10950142210936772;
+    let spec = |amplitude_max: f64| SiSpec {
+        vtol: 0.01,
+        insensitivity: Some(0.8024150574274576),
+        amplitude_min,
+        amplitude_max,
+        ..Default::default()
+    };
+    let huge = si(spec(1e12), 0.05, 0.0);
+    let reach = si(spec(30.0), 0.05, 0.0);
+    assert!(huge
+        .impulses()
+        .iter()
+        .all(|i| i.amplitude >= amplitude_min - 1e-12));
+    close(huge.amplitude_sum(), 1.0, 1e-12, "Σ A");
+    close(huge.duration(), reach.duration(), 1e-9, "duration");
+    assert_eq!(huge.len(), reach.len());
+}
+
 /// Several modes: a band around each, designed together.
 #[wasm_bindgen_test(unsupported = test)]
 fn two_modes_two_bands() {

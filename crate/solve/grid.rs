@@ -169,15 +169,17 @@ impl Program {
         }
     }
 
-    /// Nonnegative cone: bounds and increments. With A ≥ 0 and Σ A = 1, A ≤ 1 holds anyway,
-    /// so an upper bound ≥ 1 is left out.
+    /// Nonnegative cone: bounds and increments. With A ≥ A_min and Σ A = 1, no amplitude can
+    /// exceed 1 − (n − 1)·min(A_min, 0), so an upper bound at or above that is left out: it
+    /// cannot bind, and a huge one (`amplitudeMax: 1e12`) would set the interior-point
+    /// solver's scale — its tolerances are relative to the data — leaving Σ A off by 4e-5.
     fn nonnegative_cone(
         &mut self,
         problem: &NormalizedProblem,
         n_amp: usize,
         increment_max: Option<f64>,
     ) {
-        let upper = !(problem.amplitude_min >= 0.0 && problem.amplitude_max >= 1.0);
+        let upper = problem.amplitude_max < problem.amplitude_reach(n_amp);
         for k in 0..n_amp {
             self.push(k, -1.0); // A_k − A_min ≥ 0
             self.end_row(-problem.amplitude_min);

@@ -312,6 +312,20 @@ pub const MAX_LIMITS: usize = 200 * crate::mode::MAX_MODES;
 pub const MAX_BANDS: usize = crate::mode::MAX_MODES;
 
 impl NormalizedProblem {
+    /// The most any amplitude of `n` can be when they sum to 1 and none is below amplitudeMin:
+    /// 1 − (n − 1)·min(amplitudeMin, 0). An amplitudeMax at or above it cannot bind.
+    pub(crate) fn amplitude_reach(&self, n: usize) -> f64 {
+        1.0 - n.saturating_sub(1) as f64 * self.amplitude_min.min(0.0)
+    }
+
+    /// The scale of the amplitude bounds for `n` amplitudes, for tolerances and for telling an
+    /// amplitude near a bound: amplitudeMax − amplitudeMin with amplitudeMax taken at most
+    /// [`Self::amplitude_reach`] (a larger bound, up to `amplitudeMax: 1e12`, binds nothing and
+    /// must not widen the tolerances).
+    pub(crate) fn amplitude_range(&self, n: usize) -> f64 {
+        self.amplitude_max.min(self.amplitude_reach(n)) - self.amplitude_min
+    }
+
     fn new(p: &Problem) -> Result<Self> {
         check_sizes(p)?;
         check_amplitudes(p)?;
@@ -1038,9 +1052,11 @@ fn renormalize(impulses: &mut [Impulse]) {
 /// Amplitude bound slack, relative to the bounds' range: the solver's tolerance, not more.
 const BOUND_TOLERANCE: f64 = 1e-8;
 
-/// Every amplitude within [amplitudeMin, amplitudeMax] up to [`BOUND_TOLERANCE`].
+/// Every amplitude within [amplitudeMin, amplitudeMax] up to [`BOUND_TOLERANCE`] of the
+/// bounds' [`NormalizedProblem::amplitude_range`] (the range itself before 2026-12-06: with
+/// `amplitudeMax: 1e12` that let an amplitude 10⁴ below amplitudeMin through).
 fn within_bounds(norm: &NormalizedProblem, impulses: &[Impulse]) -> bool {
-    let tol = BOUND_TOLERANCE * (norm.amplitude_max - norm.amplitude_min);
+    let tol = BOUND_TOLERANCE * norm.amplitude_range(impulses.len());
     impulses
         .iter()
         .all(|i| i.amplitude >= norm.amplitude_min - tol && i.amplitude <= norm.amplitude_max + tol)

@@ -943,7 +943,7 @@ fn initial_active(
     candidates: &[PointSpec],
     top: f64,
 ) -> Active {
-    let range = norm.amplitude_max - norm.amplitude_min;
+    let range = norm.amplitude_range(start.len());
     let mut active = Active {
         bounds: start
             .iter()
