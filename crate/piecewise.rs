@@ -139,14 +139,7 @@ impl Piecewise {
     /// The command convolved with `shaper` (exact): every knot copied to τ + tᵢ with its jumps
     /// scaled by Aᵢ. Errors when the result would exceed [`MAX_KNOTS`].
     pub fn shaped(&self, shaper: &Shaper) -> Result<Piecewise> {
-        let n = self.knots.len().saturating_mul(shaper.len());
-        if n > MAX_KNOTS {
-            return Err(Error::TooLarge {
-                field: "command".into(),
-                value: n as f64,
-                limit: MAX_KNOTS as f64,
-            });
-        }
+        let n = self.shaped_len(shaper)?;
         // Knot by knot, each followed by every impulse: runs already sorted by time, which the
         // stable sort in `new` merges instead of sorting the whole (a 6-mode ZVDD shapes a
         // trapezoid into 4 runs of 4096 knots). With few knots the runs are merged here, ties
@@ -172,6 +165,19 @@ impl Piecewise {
         Piecewise::new(knots)
     }
 
+    /// The number of knots shaping by `shaper` makes before merging; errors past [`MAX_KNOTS`].
+    fn shaped_len(&self, shaper: &Shaper) -> Result<usize> {
+        let n = self.knots.len().saturating_mul(shaper.len());
+        if n > MAX_KNOTS {
+            return Err(Error::TooLarge {
+                field: "command".into(),
+                value: n as f64,
+                limit: MAX_KNOTS as f64,
+            });
+        }
+        Ok(n)
+    }
+
     /// The knots of [`Piecewise::shaped`] one by one, in time order, without forming the
     /// command: the knots `shaped(shaper)` stores, merged the same way (what walks the shaped
     /// command once, like its peaks, need not hold 62 500 knots of 80 bytes). `None` for a
@@ -182,19 +188,11 @@ impl Piecewise {
         &'a self,
         shaper: &'a Shaper,
     ) -> Result<Option<MergedKnots<ShapedRuns<'a>>>> {
-        let impulses = shaper.impulses();
-        let n = self.knots.len().saturating_mul(impulses.len());
-        if n > MAX_KNOTS {
-            return Err(Error::TooLarge {
-                field: "command".into(),
-                value: n as f64,
-                limit: MAX_KNOTS as f64,
-            });
-        }
+        self.shaped_len(shaper)?;
         if self.knots.len() > MERGED_RUNS {
             return Ok(None);
         }
-        let runs = ShapedRuns::new(&self.knots, impulses);
+        let runs = ShapedRuns::new(&self.knots, shaper.impulses());
         let span = match (runs.first_time(), runs.last_time()) {
             (Some(a), Some(b)) => merge_span(a, b),
             _ => 0.0,
