@@ -338,10 +338,13 @@ fn render_playground_takes_a_mismatch_per_mode_and_in_damping() {
 
 /// `renderPlayground` keeps the last frame's designs and analyses and reuses them while only
 /// the simulation's inputs change. Through a sequence of edits — mismatch, Vtol, square corner
-/// velocity, a mode's frequency, the family, the mismatch again — every frame's shaper,
-/// I(Vtol) and Klipper smoothing equal what `design`, `insensitivity` and `klipperFigures`
-/// compute for that frame's state from scratch (so a stale analysis would fail here), and the
-/// mismatch edits change the simulated residual but not the analysis.
+/// velocity, a mode's frequency, the family, the mismatch again, the command's acceleration —
+/// every frame's shaper, I(Vtol) and Klipper smoothing equal what `design`, `insensitivity` and
+/// `klipperFigures` compute for that frame's state from scratch, and the shaped move's own
+/// figures (its end, peak acceleration and jerk, acceleration peak-valley count, kept between
+/// frames too) what `simulate` gives for the shaped command formed from scratch (so a stale
+/// analysis or stale figures would fail here); the mismatch edits change the simulated
+/// residual but not the analysis, the command edit the figures but not the analysis.
 #[wasm_bindgen_test]
 fn analyses_kept_between_frames_follow_every_input_they_depend_on() {
     let canvases = js_sys::Object::new();
@@ -352,22 +355,26 @@ fn analyses_kept_between_frames_follow_every_input_they_depend_on() {
         path.iter()
             .fold(v.clone(), |v, k| Reflect::get(&v, &(*k).into()).unwrap())
     };
-    let edits: [(f64, f64, f64, &str, f64); 7] = [
-        (2.0, 0.05, 5.0, "zvd", 1.0),
-        (2.0, 0.05, 5.0, "zvd", 1.2),
-        (2.0, 0.10, 5.0, "zvd", 1.2),
-        (2.0, 0.10, 400.0, "zvd", 1.2),
-        (2.5, 0.10, 400.0, "zvd", 1.2),
-        (2.5, 0.10, 400.0, "ei", 1.2),
-        (2.5, 0.10, 400.0, "ei", 0.9),
+    let edits: [(f64, f64, f64, &str, f64, f64); 8] = [
+        (2.0, 0.05, 5.0, "zvd", 1.0, 8.0),
+        (2.0, 0.05, 5.0, "zvd", 1.2, 8.0),
+        (2.0, 0.10, 5.0, "zvd", 1.2, 8.0),
+        (2.0, 0.10, 400.0, "zvd", 1.2, 8.0),
+        (2.5, 0.10, 400.0, "zvd", 1.2, 8.0),
+        (2.5, 0.10, 400.0, "ei", 1.2, 8.0),
+        (2.5, 0.10, 400.0, "ei", 0.9, 8.0),
+        (2.5, 0.10, 400.0, "ei", 0.9, 3.0),
     ];
     let mut last_residual = f64::NAN;
     let mut last_analysis = String::new();
-    for (i, &(f, vtol, scv, family, mismatch)) in edits.iter().enumerate() {
+    let mut last_figures = String::new();
+    for (i, &(f, vtol, scv, family, mismatch, acc)) in edits.iter().enumerate() {
+        let command = format!(
+            r#"{{"kind":"trapezoid","distance":1,"maxVelocity":0.8,"maxAcceleration":{acc}}}"#
+        );
         let state = JSON::parse(&format!(
             r#"{{"modes":[{{"frequencyHz":{f},"damping":0.03}}],"shapers":[{{"family":"{family}"}}],
-                "view":{{"vtol":{vtol},"scv":{scv},"mismatch":{mismatch},
-                         "command":{{"kind":"trapezoid","distance":1,"maxVelocity":0.8,"maxAcceleration":8}}}}}}"#
+                "view":{{"vtol":{vtol},"scv":{scv},"mismatch":{mismatch},"command":{command}}}}}"#
         ))
         .unwrap();
         let out = wasm::render_playground(state, canvases.clone().into()).unwrap();
@@ -407,14 +414,46 @@ fn analyses_kept_between_frames_follow_every_input_they_depend_on() {
             JSON::stringify(&get(&result, &["shaper"])).unwrap(),
             get(&result, &["klipper", "smoothing"]).as_f64()
         );
-        if i > 0 && mismatch != edits[i - 1].4 {
-            assert_ne!(
-                residual, last_residual,
-                "edit {i}: the simulation follows r"
-            );
+        // The shaped command's own figures, against `simulate` of the formed command (any
+        // plant: they are the command's).
+        let keys = [
+            "moveEnd",
+            "peakAcceleration",
+            "peakJerk",
+            "accelerationPeakValleyCount",
+        ];
+        let figures_of = |metrics: &JsValue| {
+            keys.map(|k| {
+                JSON::stringify(&get(metrics, &[k]))
+                    .unwrap()
+                    .as_string()
+                    .unwrap()
+            })
+            .join(" ")
+        };
+        let figures = figures_of(&get(&result, &["simulation"]));
+        let simulated = wasm::simulate(
+            JSON::parse(&format!(
+                r#"{{"plant":{{"kind":"modal","modes":[{{"frequencyHz":{f},"damping":0.03}}]}},
+                    "command":{command},
+                    "shaper":{{"family":"{family}","modes":[{{"frequencyHz":{f},"damping":0.03}}]}}}}"#
+            ))
+            .unwrap(),
+        )
+        .unwrap();
+        assert_eq!(
+            figures,
+            figures_of(&get(&simulated, &["shaped", "metrics"])),
+            "edit {i}: the shaped move's own figures"
+        );
+        let (mismatch_edit, command_edit) = match i {
+            0 => (false, false),
+            _ => (mismatch != edits[i - 1].4, acc != edits[i - 1].5),
+        };
+        if mismatch_edit || command_edit {
             assert_eq!(
                 analysis, last_analysis,
-                "edit {i}: a mismatch edit keeps the analysis"
+                "edit {i}: a mismatch or command edit keeps the analysis"
             );
         } else if i > 0 {
             assert_ne!(
@@ -422,8 +461,21 @@ fn analyses_kept_between_frames_follow_every_input_they_depend_on() {
                 "edit {i}: the analysis follows the edit"
             );
         }
+        if mismatch_edit {
+            assert_ne!(
+                residual, last_residual,
+                "edit {i}: the simulation follows r"
+            );
+        }
+        if command_edit {
+            assert_ne!(
+                figures, last_figures,
+                "edit {i}: the figures follow the command"
+            );
+        }
         last_residual = residual;
         last_analysis = analysis;
+        last_figures = figures;
     }
 }
 
