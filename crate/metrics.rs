@@ -258,7 +258,7 @@ fn knot_figures(
 }
 
 /// Peaks of the `order`-th derivative of a piecewise command are read from its values at
-/// these points of each piece ([`sample`]): 0 before it starts, then per piece
+/// these points of each piece (`Piece::sample`): 0 before it starts, then per piece
 /// - where the derivative is constant on every piece (`order` ≥ degree: a trapezoid's
 ///   acceleration), one value: both ends would be the same number, and a repeated value changes
 ///   neither the peak nor [`peak_valley_count`];
