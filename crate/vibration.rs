@@ -92,10 +92,34 @@ pub(crate) fn vibration_moments(
 ) -> Vec<[f64; 2]> {
     let t_n = impulses.last().map_or(0.0, |imp| imp.time);
     let damped = (1.0 - zeta * zeta).sqrt();
+    moments_of_factors(
+        impulses,
+        |i| moment_factor(impulses[i].time, t_n, omega, zeta, damped),
+        k_max,
+    )
+}
+
+/// One impulse's factors in [`vibration_moments`] at time `time` (the last impulse at `t_n`,
+/// `damped` = √(1 − ζ²)): [e^{−ζω(t_n − t)}, sin ω_d t, cos ω_d t].
+#[inline]
+pub(crate) fn moment_factor(time: f64, t_n: f64, omega: f64, zeta: f64, damped: f64) -> [f64; 3] {
+    let decay = (-(zeta * omega) * (t_n - time)).exp();
+    let (sin, cos) = (omega * damped * time).sin_cos();
+    [decay, sin, cos]
+}
+
+/// The moments M₀ … M_`k_max` of [`vibration_moments`] from each impulse's factors
+/// ([`moment_factor`]; `factor(i)` for impulse i), summed in the impulses' order: the polish's
+/// Jacobian keeps the factors of the impulses a column does not move.
+#[inline]
+pub(crate) fn moments_of_factors(
+    impulses: &[Impulse],
+    factor: impl Fn(usize) -> [f64; 3],
+    k_max: u32,
+) -> Vec<[f64; 2]> {
     let mut sums = vec![[0.0, 0.0]; k_max as usize + 1];
-    for imp in impulses {
-        let decay = (-(zeta * omega) * (t_n - imp.time)).exp();
-        let (sin, cos) = (omega * damped * imp.time).sin_cos();
+    for (i, imp) in impulses.iter().enumerate() {
+        let [decay, sin, cos] = factor(i);
         for (k, sum) in sums.iter_mut().enumerate() {
             let a = if k == 0 {
                 imp.amplitude

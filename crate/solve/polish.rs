@@ -21,7 +21,7 @@ use super::{
     clusters, ratio, Cluster, GridSolution, NormalizedLimit, NormalizedProblem, CHECK_TOLERANCE,
 };
 use crate::shaper::Impulse;
-use crate::vibration::{impulse_phasor, vibration_moments};
+use crate::vibration::{impulse_phasor, moment_factor, moments_of_factors, vibration_moments};
 use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -127,6 +127,15 @@ struct Sums {
     points: Vec<(f64, f64, Vec<[f64; 2]>)>,
 }
 
+/// Each impulse's factors of the moment sums at one iterate ([`Setup::factors`]): per zero and
+/// per active point, [e^{−ζω(t_n − tᵢ)}, sin ω_d tᵢ, cos ω_d tᵢ] for every impulse i.
+struct Factors {
+    /// The last impulse's time.
+    t_n: f64,
+    zeros: Vec<Vec<[f64; 3]>>,
+    points: Vec<Vec<[f64; 3]>>,
+}
+
 /// The unknowns and equations of one Newton solve.
 #[derive(Debug, Clone)]
 struct Setup<'a> {
@@ -225,22 +234,118 @@ impl Setup<'_> {
             .collect()
     }
 
-    /// Central-difference Jacobian of c.
+    /// Central-difference Jacobian of c. A column that moves one impulse's amplitude, or the
+    /// time of one impulse but the last, changes one term of each moment sum: its residuals
+    /// keep the other impulses' factors of the iterate ([`Setup::residuals_moved`], the same
+    /// numbers as [`Setup::residuals`]; a unit test compares them on every column of every
+    /// Jacobian a design takes). The last time (the vibration's reference instant) and a free
+    /// ω or ζ move every term.
     fn jacobian(&self, y: &[f64]) -> DMatrix<f64> {
+        let m = self.m;
+        let base = self.factors(&self.impulses(y), y);
         let mut j = DMatrix::zeros(self.cons.len(), self.n);
         let mut yp = y.to_vec();
         for col in 0..self.n {
+            let moved = if col + 2 < m {
+                Some((col + 1, true))
+            } else if (m - 1..2 * m - 1).contains(&col) {
+                Some((col + 1 - m, false))
+            } else {
+                None
+            };
+            let residuals = |yy: &[f64]| match moved {
+                Some((i, time)) => {
+                    let r = self.residuals_moved(&base, yy, i, time);
+                    #[cfg(test)]
+                    assert_eq!(
+                        r.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                        self.residuals(yy)
+                            .iter()
+                            .map(|v| v.to_bits())
+                            .collect::<Vec<_>>(),
+                        "column {col}: the kept factors give the residuals to the bit"
+                    );
+                    r
+                }
+                None => self.residuals(yy),
+            };
             let h = JACOBIAN_STEP * y[col].abs().max(1.0);
             yp[col] = y[col] + h;
-            let rp = self.residuals(&yp);
+            let rp = residuals(&yp);
             yp[col] = y[col] - h;
-            let rm = self.residuals(&yp);
+            let rm = residuals(&yp);
             yp[col] = y[col];
             for (row, (a, b)) in rp.iter().zip(&rm).enumerate() {
                 j[(row, col)] = (a - b) / (2.0 * h);
             }
         }
         j
+    }
+
+    /// Each impulse's factors of the moment sums ([`moment_factor`]) at every zero and active
+    /// point, at the iterate `y` (its impulses `imps`).
+    fn factors(&self, imps: &[Impulse], y: &[f64]) -> Factors {
+        let t_n = imps.last().map_or(0.0, |i| i.time);
+        let of = |w: f64, z: f64| {
+            let damped = (1.0 - z * z).sqrt();
+            imps.iter()
+                .map(|i| moment_factor(i.time, t_n, w, z, damped))
+                .collect()
+        };
+        Factors {
+            t_n,
+            zeros: self
+                .norm
+                .zeros
+                .iter()
+                .map(|z| of(z.omega, z.zeta))
+                .collect(),
+            points: self
+                .points
+                .iter()
+                .map(|pt| of(self.coord(pt.omega, y), self.coord(pt.zeta, y)))
+                .collect(),
+        }
+    }
+
+    /// c(y) where `y` differs from the iterate of `base` only in impulse `moved`'s amplitude, or
+    /// (`time`) in its time — never the last one's: that impulse's factors are computed again,
+    /// the others taken from `base`, summed in the same order as [`Setup::residuals`] sums.
+    fn residuals_moved(&self, base: &Factors, y: &[f64], moved: usize, time: bool) -> Vec<f64> {
+        let imps = self.impulses(y);
+        let sums_of = |w: f64, z: f64, kept: &[[f64; 3]], k_max: u32| {
+            let fresh = time.then(|| {
+                let damped = (1.0 - z * z).sqrt();
+                moment_factor(imps[moved].time, base.t_n, w, z, damped)
+            });
+            moments_of_factors(
+                &imps,
+                |i| match fresh {
+                    Some(f) if i == moved => f,
+                    _ => kept[i],
+                },
+                k_max,
+            )
+        };
+        let zeros = self
+            .norm
+            .zeros
+            .iter()
+            .zip(&base.zeros)
+            .map(|(z, kept)| sums_of(z.omega, z.zeta, kept, z.derivatives))
+            .collect();
+        let points = self
+            .points
+            .iter()
+            .zip(&base.points)
+            .map(|(pt, kept)| {
+                let (w, z) = (self.coord(pt.omega, y), self.coord(pt.zeta, y));
+                let stationary =
+                    matches!(pt.omega, Coord::Free(_)) || matches!(pt.zeta, Coord::Free(_));
+                (w, z, sums_of(w, z, kept, u32::from(stationary)))
+            })
+            .collect();
+        self.rows(&Sums { zeros, points }, &imps)
     }
 
     /// Index in y of the duration t_{m−1}.
@@ -1257,5 +1362,55 @@ mod tests {
                 four[(p, q)]
             );
         }
+    }
+    /// Every Jacobian column that moves one impulse alone is computed from the iterate's kept
+    /// factors; under `cfg(test)` each such column is also computed in full and must equal it
+    /// to the bit (the assertion in [`Setup::jacobian`]). These problems take the polish through
+    /// bands over one and three damped modes (the decay factors), negative amplitudes (bound
+    /// rows) and zero-vibration constraints with their moments (a `direct` ZVD over three).
+    #[test]
+    fn jacobian_columns_from_kept_factors_are_the_full_ones() {
+        use crate::solve::{minimum_duration, Band, Problem, Tolerance, ZeroVibration};
+        let band = |f: f64, zeta: f64, half: f64| Band {
+            from_hz: f * (1.0 - half),
+            to_hz: f * (1.0 + half),
+            damping_from: zeta,
+            damping_to: zeta,
+            tolerance: Tolerance::constant(0.05).unwrap(),
+        };
+        let problem = |zeros: Vec<ZeroVibration>, bands: Vec<Band>, amplitude_min: f64| Problem {
+            zeros,
+            limits: Vec::new(),
+            bands,
+            amplitude_min,
+            amplitude_max: 1.0,
+            max_duration: None,
+        };
+        let zvd = |f: f64| ZeroVibration {
+            frequency_hz: f,
+            damping: 0.02,
+            derivatives: 1,
+        };
+        let problems = [
+            problem(Vec::new(), vec![band(0.5, 0.002, 0.35)], 0.0),
+            problem(
+                Vec::new(),
+                vec![
+                    band(1.2, 0.02, 0.15),
+                    band(3.4, 0.02, 0.15),
+                    band(7.9, 0.02, 0.15),
+                ],
+                0.0,
+            ),
+            problem(Vec::new(), vec![band(1.0, 0.05, 0.25)], -0.2),
+            problem(vec![zvd(1.2), zvd(3.4), zvd(7.9)], Vec::new(), 0.0),
+        ];
+        // The polish runs on all four (its Jacobians checked); with negative amplitudes it
+        // ends on the grid solution here.
+        let polished: Vec<bool> = problems
+            .iter()
+            .map(|p| minimum_duration(p).unwrap().polished)
+            .collect();
+        assert_eq!(polished, [true, true, false, true]);
     }
 }
