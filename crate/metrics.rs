@@ -206,7 +206,7 @@ impl CommandFigures {
     pub fn of(command: &Command) -> Result<Self> {
         match command {
             Command::Piecewise(p) => {
-                knot_figures(p.knots().iter().copied(), p.degree()).map(|(f, _)| f)
+                knot_figures(&mut p.knots().iter().copied(), p.degree()).map(|(f, _)| f)
             }
             Command::Sampled(s) => {
                 let (peak_acceleration, peak_jerk, count) = sampled_peaks(s.values(), s.period());
@@ -226,15 +226,17 @@ impl CommandFigures {
     /// reference has few knots (a six-mode ZV-D³ shapes a trapezoid into 62 500 knots). Errors
     /// as `shaped` does (too many knots, a non-finite product).
     pub fn of_shaped(reference: &Piecewise, shaper: &crate::shaper::Shaper) -> Result<Self> {
-        let Some(knots) = reference.shaped_knots(shaper)? else {
+        let Some(mut knots) = reference.shaped_knots(shaper)? else {
             return CommandFigures::of(&Command::Piecewise(reference.shaped(shaper)?));
         };
         let degree = reference.degree();
-        let (figures, seen) = knot_figures(knots.clone(), degree)?;
+        let (figures, seen) = knot_figures(&mut knots, degree)?;
         // The shaped degree is the reference's unless its highest jumps all cancel: then the
         // walk is taken again at the degree the command has (as `shaped` would store it).
         if seen < degree {
-            return knot_figures(knots, seen).map(|(f, _)| f);
+            if let Some(mut again) = reference.shaped_knots(shaper)? {
+                return knot_figures(&mut again, seen).map(|(f, _)| f);
+            }
         }
         Ok(figures)
     }
@@ -243,7 +245,7 @@ impl CommandFigures {
 /// The figures of a piecewise command given as its knots (sorted, merged) and a bound on its
 /// degree, and the degree the knots have (the highest order that jumps; 0 for none).
 fn knot_figures(
-    knots: impl Iterator<Item = Knot>,
+    knots: &mut dyn Iterator<Item = Knot>,
     degree: usize,
 ) -> Result<(CommandFigures, usize)> {
     let w = walk(knots, degree, &[2, 3], Sampling::ByDegree)?;
@@ -295,7 +297,7 @@ struct Walked {
 /// `orders` by `sampling`, keeping the Taylor state at the last knot passed as `Cursor` does
 /// (the same arithmetic, so the same bits). Errors: a non-finite knot, as `Piecewise::new`.
 fn walk(
-    knots: impl Iterator<Item = Knot>,
+    knots: &mut dyn Iterator<Item = Knot>,
     degree: usize,
     orders: &[usize],
     sampling: Sampling,
@@ -306,7 +308,6 @@ fn walk(
         end: 0.0,
         degree: 0,
     };
-    let mut knots = knots;
     let mut anchor = [0.0; ORDER];
     let mut first = true;
     let mut next = knots.next();
@@ -433,7 +434,13 @@ fn stationary_points(a: f64, b: f64, c: f64) -> Vec<f64> {
 /// dense sampling).
 #[cfg(test)]
 fn sample_derivative(p: &Piecewise, order: usize, sampling: Sampling) -> Vec<f64> {
-    let w = walk(p.knots().iter().copied(), p.degree(), &[order], sampling).unwrap();
+    let w = walk(
+        &mut p.knots().iter().copied(),
+        p.degree(),
+        &[order],
+        sampling,
+    )
+    .unwrap();
     w.samples.into_iter().next().unwrap()
 }
 

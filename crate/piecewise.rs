@@ -74,7 +74,7 @@ impl Piecewise {
             _ => 0.0,
         };
         let mut merged = Vec::with_capacity(sorted.len());
-        merged.extend(MergedKnots::new(sorted.into_iter(), span));
+        merged.extend(MergedKnots::new(Box::new(sorted.into_iter()), span));
         let degree = merged
             .iter()
             .filter_map(|k| k.jumps.iter().rposition(|&j| j != 0.0))
@@ -187,7 +187,7 @@ impl Piecewise {
     pub(crate) fn shaped_knots<'a>(
         &'a self,
         shaper: &'a Shaper,
-    ) -> Result<Option<MergedKnots<ShapedRuns<'a>>>> {
+    ) -> Result<Option<MergedKnots<'a>>> {
         self.shaped_len(shaper)?;
         if self.knots.len() > MERGED_RUNS {
             return Ok(None);
@@ -197,7 +197,7 @@ impl Piecewise {
             (Some(a), Some(b)) => merge_span(a, b),
             _ => 0.0,
         };
-        Ok(Some(MergedKnots::new(runs, span)))
+        Ok(Some(MergedKnots::new(Box::new(runs), span)))
     }
 
     /// The derivative of the command (its jumps moved one order down; the position jumps
@@ -253,7 +253,6 @@ fn merge_span(first: f64, last: f64) -> f64 {
 /// per knot of the command (shifted by every impulse, sorted since addition is monotone)
 /// merged, a tie going to the earlier run and, within a run, to the earlier impulse — the
 /// order a stable sort gives the runs' concatenation, so the same command to the last bit.
-#[derive(Clone)]
 pub(crate) struct ShapedRuns<'a> {
     runs: &'a [Knot],
     impulses: &'a [crate::shaper::Impulse],
@@ -315,16 +314,16 @@ impl Iterator for ShapedRuns<'_> {
 
 /// Knots in time order with the knots closer than [`KNOT_MERGE`] × `span` (floor 1e-15 s)
 /// merged into the first of them (jumps summed in order) and the knots whose jumps are all
-/// zero dropped: what a [`Piecewise`] keeps.
-#[derive(Clone)]
-pub(crate) struct MergedKnots<I> {
-    sorted: I,
+/// zero dropped: what a [`Piecewise`] keeps. Over a boxed iterator: one copy in the module for
+/// both of its sources (a command's sorted knots, a shaped command's runs).
+pub(crate) struct MergedKnots<'a> {
+    sorted: Box<dyn Iterator<Item = Knot> + 'a>,
     tol: f64,
     pending: Option<Knot>,
 }
 
-impl<I: Iterator<Item = Knot>> MergedKnots<I> {
-    fn new(mut sorted: I, span: f64) -> Self {
+impl<'a> MergedKnots<'a> {
+    fn new(mut sorted: Box<dyn Iterator<Item = Knot> + 'a>, span: f64) -> Self {
         let pending = sorted.next();
         MergedKnots {
             sorted,
@@ -334,7 +333,7 @@ impl<I: Iterator<Item = Knot>> MergedKnots<I> {
     }
 }
 
-impl<I: Iterator<Item = Knot>> Iterator for MergedKnots<I> {
+impl Iterator for MergedKnots<'_> {
     type Item = Knot;
 
     fn next(&mut self) -> Option<Knot> {
@@ -357,11 +356,6 @@ impl<I: Iterator<Item = Knot>> Iterator for MergedKnots<I> {
                 return Some(out);
             }
         }
-    }
-
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        let (_, hi) = self.sorted.size_hint();
-        (0, hi.map(|h| h + usize::from(self.pending.is_some())))
     }
 }
 

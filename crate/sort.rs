@@ -29,20 +29,31 @@ pub(crate) fn sort_by_f64_key<T>(v: &mut [T], key: impl Fn(&T) -> f64) {
     if n < 64 || u32::try_from(n).is_err() {
         return sort_by(v, |a, b| key(a).total_cmp(&key(b)));
     }
-    // total_cmp's order as unsigned integers: negative numbers (sign set) reversed, after them
-    // the positive ones.
-    let bits = |x: f64| {
-        let b = x.to_bits();
-        if b >> 63 == 1 {
-            !b
-        } else {
-            b | 1 << 63
-        }
-    };
-    let keys: Vec<u64> = v.iter().map(|x| bits(key(x))).collect();
-    if keys.windows(2).all(|w| w[0] <= w[1]) {
-        return;
+    let keys: Vec<u64> = v.iter().map(|x| total_order_bits(key(x))).collect();
+    if let Some(order) = radix_order(&keys) {
+        permute(v, &order);
     }
+}
+
+/// `x`'s bits as an unsigned integer in [`f64::total_cmp`]'s order: negative numbers (sign set)
+/// reversed, after them the positive ones.
+fn total_order_bits(x: f64) -> u64 {
+    let b = x.to_bits();
+    if b >> 63 == 1 {
+        !b
+    } else {
+        b | 1 << 63
+    }
+}
+
+/// The stable order of `keys` (at most u32::MAX of them) by a least-significant-digit radix
+/// sort, or `None` where they are sorted already. Not generic: one copy in the module for
+/// every caller of [`sort_by_f64_key`].
+fn radix_order(keys: &[u64]) -> Option<Vec<usize>> {
+    if keys.windows(2).all(|w| w[0] <= w[1]) {
+        return None;
+    }
+    let n = keys.len();
     let mut order: Vec<u32> = (0..n as u32).collect();
     let mut next = vec![0_u32; n];
     for shift in (0..64).step_by(8) {
@@ -64,8 +75,7 @@ pub(crate) fn sort_by_f64_key<T>(v: &mut [T], key: impl Fn(&T) -> f64) {
         }
         std::mem::swap(&mut order, &mut next);
     }
-    let order: Vec<usize> = order.into_iter().map(|i| i as usize).collect();
-    permute(v, &order);
+    Some(order.into_iter().map(|i| i as usize).collect())
 }
 
 /// Applies the permutation `order` to `v` (new[i] = old[order[i]]) cycle by cycle with swaps.
