@@ -62,8 +62,8 @@ fn step(state: (f64, f64), a: f64, w: f64, zeta: f64, h: f64) -> (f64, f64) {
     (x + xs, v)
 }
 
-/// The sensor's record of a sweep from `f0` to `f1` Hz at `rate` Hz/s, sampled at `fs`, with
-/// white noise of `noise` mm/s² (one draw of `seed`).
+/// The sensor's record of Klipper's sweep from `f0` to `f1` Hz at `rate` Hz/s, sampled at
+/// `fs`, with white noise of `noise` mm/s² (one draw of `seed`).
 fn record(
     modes: &[SimMode],
     f0: f64,
@@ -73,13 +73,26 @@ fn record(
     noise: f64,
     seed: u64,
 ) -> Vec<f64> {
+    let duration = (f1 - f0) / rate;
+    record_of(modes, duration, fs, noise, seed, |t| drive(t, f0, rate))
+}
+
+/// The sensor's record of `duration` s of the drive `a(t)` (mm/s²), sampled at `fs`, with
+/// white noise of `noise` mm/s² (one draw of `seed`).
+fn record_of(
+    modes: &[SimMode],
+    duration: f64,
+    fs: f64,
+    noise: f64,
+    seed: u64,
+    drive: impl Fn(f64) -> f64,
+) -> Vec<f64> {
     // Participation factors in the ratios that put the peaks g/(2ζ) at their relative levels.
     let weights: Vec<f64> = modes
         .iter()
         .map(|m| 2.0 * m.zeta * 10f64.powf(m.rel_db / 20.0))
         .collect();
     let sum: f64 = weights.iter().sum();
-    let duration = (f1 - f0) / rate;
     let n = (duration * fs) as usize;
     let h = 1.0 / fs;
     let mut states = vec![(0.0, 0.0); modes.len()];
@@ -88,7 +101,7 @@ fn record(
         .map(|i| {
             // The drive held over the sample interval ending at this sample (its value at the
             // interval's middle), then the modes advanced over it.
-            let a = drive((i as f64 + 0.5) * h, f0, rate);
+            let a = drive((i as f64 + 0.5) * h);
             let mut y = a;
             for ((m, st), g) in modes.iter().zip(states.iter_mut()).zip(&weights) {
                 let w = 2.0 * PI * m.f;
@@ -213,6 +226,77 @@ fn short_fast_sweeps_are_found_and_their_modes_right() {
         assert!((sweep.rate_hz_per_s / rate - 1.0).abs() < 0.05, "{sweep:?}");
         assert!((sweep.band_hz[0] - f0).abs() < 3.0, "{sweep:?}");
         assert!((sweep.band_hz[1] - f1).abs() < 3.0, "{sweep:?}");
+        assert_eq!(id.modes.len(), modes.len(), "{f0}-{f1} Hz: {:?}", id.modes);
+        for (m, s) in id.modes.iter().zip(modes) {
+            assert!(within(m, s.f, s.zeta), "{} Hz: {m:?}", s.f);
+        }
+        assert!(id.cut_off.is_none(), "{:?}", id.cut_off);
+    }
+}
+
+/// Exponential (logarithmic) sweeps, as a shaker's sine sweep runs in octaves per minute: f
+/// = f₀·e^(βt), so the sweep crawls at its start and races at its end (10 → 250 Hz in 8 s
+/// passes 4 Hz/s at 10 Hz and 100 Hz/s at 250 Hz). A sine of constant amplitude and one of
+/// amplitude ∝ f (60 mm/s² per Hz, Klipper's) through two or three base-excited modes. The
+/// sweep detector fitted only a straight line f(t): it found a sweep over the slow half alone
+/// (sweep_chirps.py's seed 1: 5.2–51.1 Hz of a 5–96.5 Hz sweep) or none, and the modes past it
+/// were missed or read from the Welch path (26 of 48 modes within the targets over that batch,
+/// 46 of 52 now). Now ln f(t) is fitted too, the top read again on shorter frames: the law,
+/// the band and the rate come back, and every mode is within issue 20's 1 % / 15 %.
+#[test]
+fn exponential_sweeps_are_found_and_their_modes_right() {
+    use input_shaping::measure::SweepLaw;
+    let fs = 3200.0;
+    // (modes, f₀, f₁, seconds, amplitude ∝ f, noise seed)
+    type Case<'a> = (&'a [SimMode], f64, f64, f64, bool, u64);
+    let cases: [Case; 4] = [
+        (
+            &[sim(45.0, 0.03, 0.0), sim(110.0, 0.06, -3.0)],
+            10.0,
+            250.0,
+            8.0,
+            true,
+            51,
+        ),
+        (
+            &[sim(45.0, 0.03, 0.0), sim(110.0, 0.06, -3.0)],
+            10.0,
+            250.0,
+            8.0,
+            false,
+            52,
+        ),
+        (
+            &[
+                sim(38.0, 0.05, 0.0),
+                sim(61.0, 0.02, -4.0),
+                sim(140.0, 0.1, -2.0),
+            ],
+            5.0,
+            300.0,
+            12.0,
+            true,
+            53,
+        ),
+        (&[sim(72.0, 0.015, 0.0)], 20.0, 200.0, 3.0, false, 54),
+    ];
+    for (modes, f0, f1, seconds, per_hz, seed) in cases {
+        let beta = (f1 / f0).ln() / seconds;
+        let chirp = |t: f64| {
+            let f = f0 * (beta * t).exp();
+            let amplitude = if per_hz { 60.0 * f } else { 4000.0 };
+            amplitude * (2.0 * PI * f0 * ((beta * t).exp() - 1.0) / beta).sin()
+        };
+        let id = identified(&record_of(modes, seconds, fs, 150.0, seed, chirp), fs);
+        let sweep = id.sweep.expect("the exponential sweep is found");
+        assert_eq!(sweep.law, SweepLaw::Exponential, "{sweep:?}");
+        assert!((sweep.band_hz[0] / f0 - 1.0).abs() < 0.25, "{sweep:?}");
+        assert!((sweep.band_hz[1] / f1 - 1.0).abs() < 0.06, "{sweep:?}");
+        let centre = (sweep.band_hz[0] * sweep.band_hz[1]).sqrt();
+        assert!(
+            (sweep.rate_at(centre) / (beta * centre) - 1.0).abs() < 0.05,
+            "{sweep:?}: β {beta}"
+        );
         assert_eq!(id.modes.len(), modes.len(), "{f0}-{f1} Hz: {:?}", id.modes);
         for (m, s) in id.modes.iter().zip(modes) {
             assert!(within(m, s.f, s.zeta), "{} Hz: {m:?}", s.f);

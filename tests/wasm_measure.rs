@@ -366,6 +366,7 @@ fn identify_modes_reports_the_sweep_of_a_raw_recording() {
     );
     let rate = get(&sweep, "rateHzPerS").as_f64().unwrap();
     assert!((rate - 2.0).abs() < 0.1, "{rate}");
+    assert_eq!(get(&sweep, "law").as_string().as_deref(), Some("linear"));
     let modes: js_sys::Array = get(&id, "modes").dyn_into().unwrap();
     let found: Vec<f64> = modes
         .iter()

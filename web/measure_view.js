@@ -178,7 +178,7 @@ function show(data) {
       + `${r.resampled ? ` (uneven time stamps, jitter ${pct(r.timing.jitter)}, resampled)` : ''}; channel ${id.channel ?? 'sum'}; `
       + `${id.spectrum.segments ? `Welch PSD with ${id.spectrum.segmentLength}-sample segments (${fmt(id.spectrum.resolutionHz, 3)} Hz bins, ${id.spectrum.segments} averaged)` : `the file's spectrum (${fmt(id.spectrum.resolutionHz, 3)} Hz bins)`}`
       + `${id.freeDecay ? `; free decay found at ${fmt(id.freeDecay.startS, 3)}–${fmt(id.freeDecay.endS, 3)} s` : ''}`
-      + `${id.sweep ? `; a sweep of ${fmt(id.sweep.bandHz[0], 3)}–${fmt(id.sweep.bandHz[1], 3)} Hz at ${fmt(id.sweep.rateHzPerS, 3)} Hz/s read from the data, modes fitted on the whole record inside it` : ''}.`);
+      + `${id.sweep ? `; ${id.sweep.law === 'exponential' ? 'an exponential' : 'a'} sweep of ${fmt(id.sweep.bandHz[0], 3)}–${fmt(id.sweep.bandHz[1], 3)} Hz at ${fmt(id.sweep.rateHzPerS, 3)} Hz/s${id.sweep.law === 'exponential' ? ' at its centre' : ''} read from the data, modes fitted on the whole record inside it` : ''}.`);
     showModes(id);
     showRecommendation(data.recommendation);
   } else {

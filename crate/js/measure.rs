@@ -457,8 +457,9 @@ mod serde_json_like {
 /// → `{ channel, modes: [{ frequencyHz, damping, frequencyUncertaintyHz, dampingUncertainty,
 /// method, peakFrequencyHz, peakPsd, prominenceDb, estimates: [...] }], spectrum: { frequencyHz,
 /// psd, … }, detectionSegmentLength, bandHz, freeDecay: { startS, endS, levelDb } | null,
-/// sweep: { bandHz, rateHzPerS } | null, sweepEndHz, cutOff, notes }` (`sweep`: the linear
-/// sweep read from a raw recording, whose modes were then fitted on its whole-record
+/// sweep: { bandHz, rateHzPerS, law } | null, sweepEndHz, cutOff, notes }` (`sweep`: the
+/// sweep read from a raw recording, `law` `'linear'` or `'exponential'` (`rateHzPerS` then at
+/// the band's geometric centre), whose modes were then fitted on its whole-record
 /// periodogram; `null` otherwise. `sweepEndHz`: a spectrum file's sweep end, the last bin
 /// fitted before its cliff, or `null`. `cutOff: { frequencyHz, prominenceDb } | null`: a
 /// response still rising there (or at a raw recording's `sweep` end), a mode peaking near or

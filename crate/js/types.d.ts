@@ -781,7 +781,11 @@ export interface Identification {
   detectionSegmentLength: number;
   bandHz: [number, number];
   freeDecay: { startS: number; endS: number; levelDb: number } | null;
-  sweep: { bandHz: [number, number]; rateHzPerS: number } | null;
+  /** The sweep read from a raw recording (its modes fitted on the whole record inside it), or
+   * `null`: linear (f = f₀ + r·t, Klipper's resonance test) or exponential (f = f₀·e^(βt), a
+   * logarithmic sine sweep), `rateHzPerS` the linear sweep's rate or the exponential one's at
+   * the band's geometric centre √(f_lo·f_hi) (its rate at f is ∝ f). */
+  sweep: { bandHz: [number, number]; rateHzPerS: number; law: 'linear' | 'exponential' } | null;
   /** A spectrum file's sweep end (the last bin fitted before its cliff), Hz, or `null`. */
   sweepEndHz: number | null;
   /** A response still rising where the sweep ends (a spectrum file's cliff, or the end of a

@@ -21,6 +21,8 @@ pub mod recommend;
 pub mod recording;
 pub mod spectrum_file;
 
-pub use identify::{identify, CutOff, Identification, IdentifiedMode, IdentifyOptions, SignalKind};
+pub use identify::{
+    identify, CutOff, Identification, IdentifiedMode, IdentifyOptions, SignalKind, Sweep, SweepLaw,
+};
 pub use psd::{fft_spectrum, welch, FftOptions, Psd, WelchOptions, WindowKind};
 pub use recording::{parse_recording, Recording, RecordingOptions, RecordingParser};

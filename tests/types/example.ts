@@ -166,7 +166,8 @@ export async function main(canvas: HTMLCanvasElement): Promise<void> {
     const pick = recommendShaper(id.spectrum, id.modes, { criterion: "klipper" });
     drawSpectrum(canvas, psd, { peaksHz: id.modes.map((m) => m.frequencyHz) });
     drawKlipperChart(canvas, { frequencyHz: psd.frequencyHz, psdSum: psd.psd }, { maxHz: 200 });
-    console.log(klipperPsd.enbwBins, fft.resolutionHz, pick.ranked[pick.recommended].label, id.sweep?.rateHzPerS);
+    const law: 'linear' | 'exponential' | undefined = id.sweep?.law;
+    console.log(klipperPsd.enbwBins, fft.resolutionHz, pick.ranked[pick.recommended].label, id.sweep?.rateHzPerS, law);
   } else {
     const fromFile = identifyModes(parsed);
     console.log(parsed.shapers.map((s) => s.name), fromFile.modes.length);

@@ -3,12 +3,13 @@
 //! vibration frequencies … The system identification can also be accomplished in the time
 //! domain").
 //!
-//! 0. **Sweep** (raw recordings, identify/sweep.rs). When the excitation is a linear sweep (as
-//!    Klipper's resonance test drives the toolhead), read from the data itself — the ridge of
-//!    short frames, a robust straight line f(t) — the modes are found and fitted on the whole
-//!    record's periodogram (rectangular window, linear trend removed) inside the swept band
-//!    less √r at each end (r in Hz/s, at least 4 bins; identify/raw.rs): there the periodogram
-//!    is |H|²·|A|² with |A(f)|² ∝ f² smooth, while a Welch average of shorter segments is lumpy
+//! 0. **Sweep** (raw recordings, identify/sweep.rs). When the excitation is a sweep — linear
+//!    (as Klipper's resonance test drives the toolhead) or exponential (a shaker's logarithmic
+//!    sine sweep) — read from the data itself (the ridge of short frames, a robust straight
+//!    line f(t) or ln f(t)), the modes are found and fitted on the whole record's periodogram
+//!    (rectangular window, linear trend removed) inside the swept band less √r at each end
+//!    (r the rate there in Hz/s, at least 4 bins; identify/raw.rs): there the periodogram
+//!    is |H|²·|A|² with |A(f)|² smooth (a power of f), while a Welch average of shorter segments is lumpy
 //!    (each segment sees a few hertz of the sweep) and outside the band there is only noise.
 //!    Steps 1–3 then run on that periodogram (peaks smoothed over about √r/4, the
 //!    rectangular window's kernel in the fit); `spectrum` stays the detection PSD. Peaks
@@ -69,7 +70,7 @@ use model::{fit_modes, ModelInput, Seed, WindowSpec};
 use serde::{Deserialize, Serialize};
 use spectrum_fit::spectrum_fit;
 use sweep::detect_sweep;
-pub use sweep::Sweep;
+pub use sweep::{Sweep, SweepLaw};
 
 /// One mode on its way out: where its peak is and every estimate made of it.
 struct Slot {
@@ -509,9 +510,13 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         // for sweeps, would read its lumps as modes.
         result.sweep = sweep;
         if stage.is_none() {
+            let law = match s.law {
+                SweepLaw::Linear => "",
+                SweepLaw::Exponential => "an exponential sweep, ",
+            };
             result.notes.push(format!(
-                "A sweep was found ({:.1}–{:.1} Hz at {:.2} Hz/s) but no mode stands out in \
-                 the band fitted inside it: the response there is flat, or the band is too \
+                "A sweep was found ({:.1}–{:.1} Hz, {law}at {:.2} Hz/s) but no mode stands out \
+                 in the band fitted inside it: the response there is flat, or the band is too \
                  narrow for this sweep rate.",
                 s.band_hz[0], s.band_hz[1], s.rate_hz_per_s
             ));
@@ -577,7 +582,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
     let joint = joint_fit(&input, &halves, beyond, options.max_modes, &mut slots);
     if let (Some(r), Some(s)) = (rising, result.sweep) {
         // Within the stretch the top was taken from (`raw::rising_into_top`).
-        let near_hz = s.rate_hz_per_s.sqrt().max(2.0 * psd.resolution_hz);
+        let near_hz = s.rate_at(s.band_hz[1]).sqrt().max(2.0 * psd.resolution_hz);
         let top_hz = psd.frequency_hz[r.top];
         result.cut_off = cut_off(joint, &halves, top_hz, near_hz).then_some(CutOff {
             frequency_hz: s.band_hz[1],

@@ -244,8 +244,8 @@ pub(super) fn welch_stage(
 
 /// The sweep path: the whole record's periodogram (rectangular window, linear trend removed:
 /// the sensor's drift), searched and fitted inside the swept band less a margin at each end
-/// where the excitation's spectrum is not smooth (a linear chirp's spectrum ripples within
-/// about √r of its ends, r the sweep rate in Hz/s; at least 4 bins). The peaks are those of
+/// where the excitation's spectrum is not smooth (a chirp's spectrum ripples within about √r
+/// of its ends, r the sweep rate in Hz/s there; at least 4 bins). The peaks are those of
 /// the periodogram smoothed over about √r/4. A response still rising into the band's top —
 /// the highest bin of the periodogram smoothed over about √r within √r of the top, standing
 /// `minProminenceDb` over its left flank (`peaks::rising_into_end`) — is returned as
@@ -263,16 +263,19 @@ pub(super) fn sweep_stage(
 ) -> Result<Option<Stage>> {
     let psd = periodogram(signal, fs)?;
     let df = psd.resolution_hz;
-    let root = sweep.rate_hz_per_s.sqrt();
-    let margin = root.max(4.0 * df);
+    // √r where the sweep starts and ends (the margins), and in the middle of the band fitted
+    // (the smoothing: an exponential sweep's rate grows with the frequency).
+    let root_at = |f: f64| sweep.rate_at(f).sqrt();
+    let (low_root, top_root) = (root_at(sweep.band_hz[0]), root_at(sweep.band_hz[1]));
     let fit_band = [
-        band[0].max(sweep.band_hz[0] + margin),
-        band[1].min(sweep.band_hz[1] - margin),
+        band[0].max(sweep.band_hz[0] + low_root.max(4.0 * df)),
+        band[1].min(sweep.band_hz[1] - top_root.max(4.0 * df)),
     ];
     let (lo, hi) = bins(&psd, fit_band);
     if hi <= lo + 16 {
         return Ok(None);
     }
+    let root = root_at((fit_band[0] * fit_band[1]).sqrt());
     let h = ((0.125 * root / df).round() as usize).clamp(1, 200);
     // Peaks standing out on both sides inside the band; then peaks whose high side the band's
     // end cuts, their prominence read on through the sweep's end (past it the periodogram falls
@@ -328,7 +331,7 @@ pub(super) fn sweep_stage(
     let local = start_peaks(&psd, sweep, band, fit_band, h, options);
     // Rising into the top, or else the highest peak without its 3 dB fall (a mode whose high
     // side the band's end cuts: seeded at its own frequency, a mode if the fit holds it).
-    let rising = rising_into_top(&psd, &heavy, lo, h2, root, options.min_prominence_db)
+    let rising = rising_into_top(&psd, &heavy, lo, h2, top_root, options.min_prominence_db)
         .map(|(prominence_db, top)| Rising {
             prominence_db,
             top,
@@ -500,7 +503,7 @@ fn start_peaks(
         MAX_MODES,
         h,
     );
-    let widest = 0.25 * sweep.rate_hz_per_s.sqrt();
+    let widest = 0.25 * sweep.rate_at(fit_band[0]).sqrt();
     let widths = half_powers(
         psd,
         &peaks,

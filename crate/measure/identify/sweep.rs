@@ -20,6 +20,13 @@
 //! line over the inlying frames, widened by half a frame's worth of sweep at each end (a
 //! frame's ridge is the mean frequency over the frame).
 //!
+//! Exponential sweeps too (f = f₀·e^(βt): a shaker's logarithmic sine sweep, octaves per
+//! minute): the same robust line through ln f(t), kept when it holds for more frames than the
+//! straight one; its late frames, which smear β·f·T each, are allowed a quarter of that, and
+//! its top is read again on shorter frames. Until 2026-12-06 only the straight line was
+//! fitted: 5 → 97 Hz in 4 s came out as a linear sweep over 5–51 Hz, and the modes past it
+//! were lost (benches/reference/sweep_chirps.py, docs/measured-data.md).
+//!
 //! Why it matters: a Welch average of a sweep with segments shorter than the record is lumpy
 //! (each segment sees a few hertz of the sweep), and outside the swept band the PSD is noise and
 //! harmonics, not the modal response. The whole record's periodogram of a sweep is
@@ -31,14 +38,41 @@ use crate::measure::fft::{Complex, Fft};
 use crate::measure::psd::{window, WindowKind};
 use serde::Serialize;
 
-/// A sweep found in a recording (JS: `{ bandHz, rateHzPerS }`).
+/// How a sweep's frequency moves with time (JS: `'linear'` | `'exponential'`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SweepLaw {
+    /// f(t) = f₀ + r·t: Klipper's resonance test (`hz_per_sec`), a linear chirp.
+    Linear,
+    /// f(t) = f₀·e^(β·t): a logarithmic (exponential) chirp, a shaker's usual sine sweep in
+    /// octaves per minute; its rate β·f grows with the frequency.
+    Exponential,
+}
+
+/// A sweep found in a recording (JS: `{ bandHz, rateHzPerS, law }`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "camelCase")]
 pub struct Sweep {
     /// Lowest and highest frequency swept, Hz.
     pub band_hz: [f64; 2],
-    /// Sweep rate, Hz/s (its magnitude).
+    /// Sweep rate, Hz/s (its magnitude): the rate of a linear sweep; an exponential sweep's
+    /// at the band's geometric centre √(f_lo·f_hi) (see [`Sweep::rate_at`]).
     pub rate_hz_per_s: f64,
+    /// Linear or exponential.
+    pub law: SweepLaw,
+}
+
+impl Sweep {
+    /// The rate at which the sweep passes `frequency_hz`, Hz/s: `rate_hz_per_s` for a linear
+    /// sweep, ∝ the frequency for an exponential one.
+    pub fn rate_at(&self, frequency_hz: f64) -> f64 {
+        match self.law {
+            SweepLaw::Linear => self.rate_hz_per_s,
+            SweepLaw::Exponential => {
+                self.rate_hz_per_s * frequency_hz / (self.band_hz[0] * self.band_hz[1]).sqrt()
+            }
+        }
+    }
 }
 
 /// Each frame's power spectrum (Hann, mean removed; bins `0..len/2`) and its power above the
@@ -199,7 +233,10 @@ pub(super) fn detect_sweep(signal: &[f64], fs: f64) -> Option<Sweep> {
         if signal.len() >= 4 * len {
             let span_bins = if len == first { 8.0 } else { 4.0 };
             if let Some(s) = sweep_with_frames(signal, fs, len, span_bins) {
-                return Some(s);
+                return Some(match s.law {
+                    SweepLaw::Linear => s,
+                    SweepLaw::Exponential => exponential_top(signal, fs, len, last, s),
+                });
             }
         }
         if len / 2 < last {
@@ -209,17 +246,116 @@ pub(super) fn detect_sweep(signal: &[f64], fs: f64) -> Option<Sweep> {
     }
 }
 
+/// An exponential sweep found on frames of `len` samples, its top read again on shorter frames
+/// (down to `last` samples): its rate grows with the frequency, so the frames that resolve
+/// its slow start smear its fast end (5 → 258 Hz in 6 s passes 170 Hz/s at the top, 220 Hz in
+/// a 1.3 s frame, whose strongest bin then lies well under the sweep: the band ended at
+/// 220 Hz), and halving the frame halves the smear. The highest top of those that find the
+/// same law at the same growth (within 15 %) is kept; the start stays the long frames'.
+fn exponential_top(signal: &[f64], fs: f64, len: usize, last: usize, found: Sweep) -> Sweep {
+    let growth = |s: &Sweep| s.rate_hz_per_s / (s.band_hz[0] * s.band_hz[1]).sqrt();
+    let mut out = found;
+    let mut shorter = len / 2;
+    while shorter >= last && signal.len() >= 4 * shorter {
+        if let Some(s) = sweep_with_frames(signal, fs, shorter, 4.0) {
+            if s.law == SweepLaw::Exponential
+                && (growth(&s) / growth(&found) - 1.0).abs() <= 0.15
+                && s.band_hz[1] > out.band_hz[1]
+            {
+                out.band_hz[1] = s.band_hz[1];
+            }
+        }
+        shorter /= 2;
+    }
+    out.rate_hz_per_s = growth(&found) * (out.band_hz[0] * out.band_hz[1]).sqrt();
+    out
+}
+
 /// The sweep as frames of `len` samples see it, spanning at least `span_bins` of their bins
-/// (see `detect_sweep`).
+/// (see `detect_sweep`): the law whose line holds for more frames, linear on a tie (a narrow
+/// exponential sweep is nearly linear, and either reads it).
 fn sweep_with_frames(signal: &[f64], fs: f64, len: usize, span_bins: f64) -> Option<Sweep> {
     let frames = ridge(signal, fs, len);
     let n = frames.len();
     if n < 8 {
         return None;
     }
-    // Theil–Sen: the median of the pairwise slopes, over at most 400 evenly spread frames (a
-    // long record would otherwise make millions of pairs).
-    let picked: Vec<(f64, f64)> = frames.iter().step_by(n.div_ceil(400)).copied().collect();
+    let bin = fs / len as f64;
+    let frame_s = len as f64 / fs;
+    let linear = law_line(&frames, SweepLaw::Linear, bin, frame_s);
+    let exponential = law_line(&frames, SweepLaw::Exponential, bin, frame_s);
+    let held = |l: &Option<LawLine>| l.as_ref().map_or(0, |l| l.within_two_bins);
+    let (law, fit) = if held(&exponential) > held(&linear) + (n / 20).max(1) {
+        (SweepLaw::Exponential, exponential?)
+    } else {
+        (SweepLaw::Linear, linear?)
+    };
+    if fit.inliers < 8 || (fit.inliers as f64) < 0.6 * n as f64 {
+        return None;
+    }
+    // The line over the inlying frames, widened by half a frame's worth of sweep at each end.
+    let half_frame = 0.5 * len as f64 / fs;
+    let (ga, gb) = (
+        fit.intercept + fit.slope * fit.first_s,
+        fit.intercept + fit.slope * fit.last_s,
+    );
+    let widen = (half_frame * fit.slope).abs();
+    let (lo, hi) = (ga.min(gb) - widen, ga.max(gb) + widen);
+    let band = match law {
+        SweepLaw::Linear => [lo, hi],
+        SweepLaw::Exponential => [lo.exp(), hi.exp()],
+    };
+    if band[1] - band[0] < span_bins * bin || band[0] <= 0.0 {
+        return None;
+    }
+    let rate = match law {
+        SweepLaw::Linear => fit.slope.abs(),
+        SweepLaw::Exponential => fit.slope.abs() * (band[0] * band[1]).sqrt(),
+    };
+    Some(Sweep {
+        band_hz: band,
+        rate_hz_per_s: rate,
+        law,
+    })
+}
+
+/// A robust line g(f(t)) = intercept + slope·t through the ridge's frames, g the identity for
+/// a linear sweep and ln for an exponential one: Theil–Sen (the median of the pairwise slopes,
+/// over at most 400 evenly spread frames: a long record would otherwise make millions of
+/// pairs), the frames within two bins of it in frequency as inliers, then least squares over
+/// them. An exponential sweep's frames are allowed a quarter of what the sweep passes in a
+/// frame more (β·f·T/4, T the frame's length): its rate grows with f, and a frame late in a
+/// wide one smears tens of hertz (5 → 300 Hz in 10 s passes 80 Hz/s at 200 Hz), its
+/// strongest bin anywhere in the middle of the smear. The laws are compared on the frames
+/// within two bins alone (the allowance would favour the exponential law on a linear sweep).
+struct LawLine {
+    intercept: f64,
+    slope: f64,
+    /// How many frames lie near the robust line (the line's own allowance).
+    inliers: usize,
+    /// How many lie within two bins of it.
+    within_two_bins: usize,
+    /// The first and last inlying frames' centres, s.
+    first_s: f64,
+    last_s: f64,
+}
+
+fn law_line(frames: &[(f64, f64)], law: SweepLaw, bin: f64, frame_s: f64) -> Option<LawLine> {
+    type Map = fn(f64) -> f64;
+    let (g, inverse): (Map, Map) = match law {
+        SweepLaw::Linear => (|f| f, |g| g),
+        SweepLaw::Exponential => (f64::ln, f64::exp),
+    };
+    let mapped: Vec<(f64, f64)> = frames
+        .iter()
+        .filter(|p| p.1 > 0.0)
+        .map(|p| (p.0, g(p.1)))
+        .collect();
+    let n = mapped.len();
+    if n < 2 {
+        return None;
+    }
+    let picked: Vec<(f64, f64)> = mapped.iter().step_by(n.div_ceil(400)).copied().collect();
     let p = picked.len();
     let mut slopes = Vec::with_capacity(p * (p - 1) / 2);
     for i in 0..p {
@@ -228,29 +364,37 @@ fn sweep_with_frames(signal: &[f64], fs: f64, len: usize, span_bins: f64) -> Opt
         }
     }
     let r0 = median(&mut slopes);
-    let mut offsets: Vec<f64> = frames.iter().map(|p| p.1 - r0 * p.0).collect();
+    let mut offsets: Vec<f64> = mapped.iter().map(|p| p.1 - r0 * p.0).collect();
     let b0 = median(&mut offsets);
-    let bin = fs / len as f64;
-    let inliers: Vec<(f64, f64)> = frames
+    let smear = match law {
+        SweepLaw::Linear => 0.0,
+        SweepLaw::Exponential => 0.25 * r0.abs() * frame_s,
+    };
+    let off = |p: &(f64, f64)| {
+        let f = inverse(b0 + r0 * p.0);
+        ((inverse(p.1) - f).abs(), f)
+    };
+    let strict: Vec<(f64, f64)> = mapped
         .iter()
         .copied()
-        .filter(|p| (p.1 - b0 - r0 * p.0).abs() <= 2.0 * bin)
+        .filter(|p| off(p).0 <= 2.0 * bin)
         .collect();
-    if inliers.len() < 8 || (inliers.len() as f64) < 0.6 * n as f64 {
-        return None;
-    }
-    let (b, r) = line(&inliers)?;
-    let t0 = inliers.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
-    let t1 = inliers.iter().map(|p| p.0).fold(0.0, f64::max);
-    let half = 0.5 * len as f64 / fs * r.abs();
-    let (fa, fb) = (b + r * t0, b + r * t1);
-    let band = [fa.min(fb) - half, fa.max(fb) + half];
-    if band[1] - band[0] < span_bins * bin || band[0] <= 0.0 {
-        return None;
-    }
-    Some(Sweep {
-        band_hz: band,
-        rate_hz_per_s: r.abs(),
+    let near: Vec<(f64, f64)> = mapped
+        .iter()
+        .copied()
+        .filter(|p| {
+            let (d, f) = off(p);
+            d <= 2.0 * bin + smear * f
+        })
+        .collect();
+    let (intercept, slope) = line(&near)?;
+    Some(LawLine {
+        intercept,
+        slope,
+        inliers: near.len(),
+        within_two_bins: strict.len(),
+        first_s: near.iter().map(|p| p.0).fold(f64::INFINITY, f64::min),
+        last_s: near.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max),
     })
 }
 
@@ -266,6 +410,7 @@ mod tests {
         let (f0, r, dur) = (20.0, 4.0, 15.0);
         let x = square_sweep(f0, r, dur, fs);
         let s = detect_sweep(&x, fs).unwrap();
+        assert_eq!(s.law, SweepLaw::Linear, "{s:?}");
         assert!((s.rate_hz_per_s - r).abs() < 0.05 * r, "{s:?}");
         assert!((s.band_hz[0] - f0).abs() < 2.0, "{s:?}");
         assert!((s.band_hz[1] - (f0 + r * dur)).abs() < 2.0, "{s:?}");
@@ -319,6 +464,43 @@ mod tests {
             .collect()
     }
 
+    /// An exponential sweep, f = f₀·e^(βt) (a square wave of amplitude ∝ f from 10 to 400 Hz
+    /// in 6 s, and a sine of constant amplitude from 5 to 200 Hz in 2.5 s): the law, the band
+    /// and the growth β come back (the rate at f is β·f). A straight line f(t) held for the
+    /// slow start alone: 10 → 400 Hz was read as a linear sweep over 10–120 Hz.
+    #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
+    fn finds_an_exponential_sweep() {
+        let fs = 3200.0;
+        for (f0, f1, dur, square) in [(10.0, 400.0, 6.0, true), (5.0, 200.0, 2.5, false)] {
+            let beta = f64::ln(f1 / f0) / dur;
+            let x: Vec<f64> = (0..(dur * fs) as usize)
+                .map(|i| {
+                    let t = i as f64 / fs;
+                    let s =
+                        (2.0 * std::f64::consts::PI * f0 * ((beta * t).exp() - 1.0) / beta).sin();
+                    if square {
+                        f0 * (beta * t).exp() * s.signum()
+                    } else {
+                        s
+                    }
+                })
+                .collect();
+            let s = detect_sweep(&x, fs).unwrap();
+            assert_eq!(s.law, SweepLaw::Exponential, "{s:?}");
+            assert!((s.band_hz[0] / f0 - 1.0).abs() < 0.3, "{s:?}");
+            assert!((s.band_hz[1] / f1 - 1.0).abs() < 0.05, "{s:?}");
+            // Within 8 %: a frame late in the sweep smears tens of hertz, its strongest bin
+            // leaning to the side where the drive puts more power per hertz (only √r, the
+            // width of the excitation's ripple, is read from the rate: 4 % in √r).
+            for f in [20.0, 100.0] {
+                assert!(
+                    (s.rate_at(f) / (beta * f) - 1.0).abs() < 0.08,
+                    "{s:?}: β {beta}"
+                );
+            }
+        }
+    }
+
     /// Short records: 20 → 120 Hz in 2 s (a fast sweep: frames of a second would each smear
     /// 50 Hz, and the record holds fewer than four of them) and 23 → 32.6 Hz at 2 Hz/s in
     /// 4.8 s (a narrow sweep whose fundamental dwells in each of the 0.64 s frames' bins for
@@ -329,6 +511,7 @@ mod tests {
     fn finds_short_fast_and_short_narrow_sweeps() {
         let fs = 3200.0;
         let s = detect_sweep(&square_sweep(20.0, 50.0, 2.0, fs), fs).unwrap();
+        assert_eq!(s.law, SweepLaw::Linear, "{s:?}");
         assert!((s.rate_hz_per_s - 50.0).abs() < 0.05 * 50.0, "{s:?}");
         assert!((s.band_hz[0] - 20.0).abs() < 4.0, "{s:?}");
         assert!((s.band_hz[1] - 120.0).abs() < 4.0, "{s:?}");
