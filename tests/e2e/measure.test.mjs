@@ -171,3 +171,41 @@ test('a 10^6-row file loads in chunks with progress shown', async () => {
   assert.deepEqual(problems, []);
   await page.close();
 });
+
+/** A logarithmic sine sweep, 10 → 250 Hz in 6 s at 1600 Hz (4000 mm/s²), through one
+ * base-excited mode of 62 Hz, ζ 0.04: the mode advanced exactly over each sample with the drive
+ * held (x'' + 2ζωx' + ω²x = −a), the sensor reading a + x'' (as tests/identify_raw_sweep.rs). */
+function exponentialSweepCsv() {
+  const fs = 1600; const [f0, f1, seconds] = [10, 250, 6];
+  const beta = Math.log(f1 / f0) / seconds;
+  const w = 2 * Math.PI * 62; const z = 0.04; const h = 1 / fs;
+  const wd = w * Math.sqrt(1 - z * z); const s = z * w;
+  const e = Math.exp(-s * h); const c = Math.cos(wd * h); const sn = Math.sin(wd * h);
+  let x = 0; let v = 0;
+  const lines = ['#time,accel_x,accel_y,accel_z'];
+  for (let i = 0; i < seconds * fs; i++) {
+    const t = (i + 0.5) * h;
+    const a = 4000 * Math.sin(2 * Math.PI * f0 * (Math.exp(beta * t) - 1) / beta);
+    const xs = -a / (w * w); const x0 = x - xs;
+    x = e * (x0 * c + (v + s * x0) / wd * sn) + xs;
+    v = e * (v * c - (w * w * x0 + s * v) / wd * sn);
+    const y = a + (-a - 2 * z * w * v - w * w * x);
+    lines.push(`${(100 + i * h).toFixed(6)},${y.toFixed(3)},0,9806.65`);
+  }
+  return lines.join('\n');
+}
+
+test('an exponential (logarithmic) sweep is said to be one, and its mode is found', async () => {
+  const { page, problems } = await env.page({ width: 1280, height: 1000 });
+  await loadFile(page, 'raw_data_x_logsweep.csv', exponentialSweepCsv());
+  await page.waitForSelector('#measure-modes tbody tr[data-mode]', { timeout: 120000 });
+  const status = await page.textContent('#measure-status');
+  const said = status.match(/an exponential sweep of ([\d.]+)–([\d.]+) Hz at ([\d.]+) Hz\/s at its centre/);
+  assert.ok(said, status);
+  assert.ok(Number(said[1]) < 15 && Math.abs(Number(said[2]) / 250 - 1) < 0.06, said[0]);
+  const modes = await modesInTable(page);
+  assert.equal(modes.length, 1, JSON.stringify(modes));
+  assert.ok(Math.abs(modes[0].frequencyHz / 62 - 1) < 0.01 && Math.abs(modes[0].damping / 0.04 - 1) < 0.15, JSON.stringify(modes));
+  assert.deepEqual(problems, []);
+  await page.close();
+});

@@ -258,6 +258,7 @@ fn local_fits(psd: &Psd, locals: &[raw::Local], kind: SignalKind, slots: &mut Ve
             band: l.band,
             sweep_end_hz: None,
             stationary: false,
+            rough_below_hz: 0.0,
         };
         let seed = Seed {
             frequency_hz: l.half.estimate.frequency_hz,
@@ -566,6 +567,13 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         band,
         sweep_end_hz: result.sweep.map(|s| s.band_hz[1]),
         stationary: result.sweep.is_none(),
+        // Klipper's pulse train steps its frequency by r/(2f) every cycle: near a fast
+        // sweep's start the steps are wide and its spectrum lumpy up to about 4√r (5 → 200 Hz
+        // in 2 s: ±3–7 dB over a few hertz up to ~30 Hz); a sine chirp's ripple stays within
+        // √r of its start, inside the band's margin.
+        rough_below_hz: result
+            .sweep
+            .map_or(0.0, |s| 4.0 * s.rate_at(s.band_hz[0]).sqrt()),
     };
     // A response rising into a sweep's end: as for a spectrum file's cliff
     // (`identify_spectrum`), a mode seeded past the band, reported as cut off unless the fit
@@ -676,6 +684,7 @@ pub fn identify_spectrum(
         band: [f_lo, f_hi],
         sweep_end_hz: end.map(|e| spectrum::end_hz(&grid, e)),
         stationary: false,
+        rough_below_hz: 0.0,
     };
     // A response still rising into the sweep's end: fitted with a mode seeded past the band
     // (its flank would otherwise be read as modes under the cliff), and reported as cut off
