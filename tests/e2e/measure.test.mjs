@@ -209,6 +209,7 @@ test('an exponential (logarithmic) sweep is said to be one, and its mode is foun
   const modes = await modesInTable(page);
   assert.equal(modes.length, 1, JSON.stringify(modes));
   assert.ok(Math.abs(modes[0].frequencyHz / 62 - 1) < 0.01 && Math.abs(modes[0].damping / 0.04 - 1) < 0.15, JSON.stringify(modes));
+  await page.locator('#measure').screenshot({ path: `${SCREENSHOTS}measure-exponential-sweep.png` });
   assert.deepEqual(problems, []);
   await page.close();
 });
