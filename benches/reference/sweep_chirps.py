@@ -192,13 +192,19 @@ def write(out, name, modes, plant, kind, flat, fs, duration, start, end, per_hz,
 def fixtures(out):
     """The fixed recordings of tests/data/sweeps/: Klipper's pulse train made fast (5 -> 200 Hz
     and 5 -> 133 Hz in 2 s) through one low-pass mode (77.7 Hz, zeta 0.095; 61 Hz, zeta 0.18),
-    whose lumpy start the joint fit's residual search took for modes until 2026-12-06."""
+    whose lumpy start the joint fit's residual search took for modes until 2026-12-06; and a
+    flat logarithmic sweep through three low-pass modes, read 2-10 % off until the joint fit
+    tried the low-pass mode form (2026-12-06)."""
     rng = np.random.default_rng(2107)
     cases = [write(out, "fastpulses77", [(77.7, 0.095, 0.0)], "lowpass", "pulses", False, 3200.0,
                    2.0, 5.0, 200.0, 60.0, 286.0, rng)]
     # issue 20's own 61 Hz, zeta 0.18 example, swept 5 -> 133 Hz in 2 s
     cases.append(write(out, "fastpulses61", [(61.0, 0.18, 0.0)], "lowpass", "pulses", False,
                        3200.0, 2.0, 5.0, 133.0, 60.0, 150.0, rng))
+    # a flat logarithmic sine sweep (5 -> 258 Hz in 6 s at 1 kHz) through three low-pass modes
+    cases.append(write(out, "logflat3", [(65.4, 0.1155, 0.0), (113.1, 0.0376, -3.9),
+                                         (174.9, 0.1541, -3.8)], "lowpass", "log", True, 1000.0,
+                       6.0, 5.0, 258.2, 60.0, 116.6, rng))
     with open(os.path.join(out, "manifest.json"), "w") as fh:
         json.dump(cases, fh, indent=1)
 
