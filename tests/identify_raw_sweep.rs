@@ -123,6 +123,17 @@ fn all_found(id: &Identification, modes: &[SimMode], label: &str) {
     assert!(id.cut_off.is_none(), "{:?}", id.cut_off);
 }
 
+/// The identification of a Klipper raw CSV's `accel_x` with the default options.
+fn identified_file(text: &str) -> Identification {
+    let options = input_shaping::measure::RecordingOptions::default();
+    let Ok(input_shaping::measure::recording::Parsed::Recording(r)) =
+        input_shaping::measure::recording::parse_file(text, &options)
+    else {
+        panic!("not a raw recording");
+    };
+    identified(&r.channel("accel_x").unwrap().values, r.sample_rate_hz)
+}
+
 fn identified(signal: &[f64], fs: f64) -> Identification {
     identify(signal, &IdentifyOptions::new(fs)).unwrap()
 }
@@ -329,13 +340,7 @@ fn a_fast_pulse_sweeps_lumpy_start_makes_no_modes() {
             0.18,
         ),
     ] {
-        let options = input_shaping::measure::RecordingOptions::default();
-        let Ok(input_shaping::measure::recording::Parsed::Recording(r)) =
-            input_shaping::measure::recording::parse_file(text, &options)
-        else {
-            panic!("not a raw recording");
-        };
-        let id = identified(&r.channel("accel_x").unwrap().values, r.sample_rate_hz);
+        let id = identified_file(text);
         assert!(id.sweep.is_some(), "{f} Hz: no sweep");
         assert_eq!(id.modes.len(), 1, "{f} Hz: {:?}", id.modes);
         assert!(within(&id.modes[0], f, zeta), "{:?}", id.modes[0]);
@@ -351,14 +356,7 @@ fn a_fast_pulse_sweeps_lumpy_start_makes_no_modes() {
 /// no more modes: every mode within issue 20's targets.
 #[test]
 fn low_pass_modes_under_a_logarithmic_sweep_are_right() {
-    let text = include_str!("data/sweeps/raw_data_x_logflat3.csv");
-    let options = input_shaping::measure::RecordingOptions::default();
-    let Ok(input_shaping::measure::recording::Parsed::Recording(r)) =
-        input_shaping::measure::recording::parse_file(text, &options)
-    else {
-        panic!("not a raw recording");
-    };
-    let id = identified(&r.channel("accel_x").unwrap().values, r.sample_rate_hz);
+    let id = identified_file(include_str!("data/sweeps/raw_data_x_logflat3.csv"));
     let sweep = id.sweep.expect("the sweep is found");
     assert_eq!(sweep.law, input_shaping::measure::SweepLaw::Exponential);
     let modes = [
@@ -419,14 +417,7 @@ fn raw_sweep_ends() {
             .map(|m| (m[0].as_f64().unwrap(), m[1].as_f64().unwrap()))
             .collect();
         let text = std::fs::read_to_string(format!("{dir}/raw_data_x_{name}.csv")).unwrap();
-        let options = input_shaping::measure::RecordingOptions::default();
-        let Ok(input_shaping::measure::recording::Parsed::Recording(r)) =
-            input_shaping::measure::recording::parse_file(&text, &options)
-        else {
-            panic!("{name}: not a raw recording");
-        };
-        let x = &r.channel("accel_x").unwrap().values;
-        let id = identified(x, r.sample_rate_hz);
+        let id = identified_file(&text);
         let mut line = Vec::new();
         for &(f, z) in &truth {
             let ok = id.modes.iter().any(|m| within(m, f, z));
