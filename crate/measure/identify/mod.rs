@@ -280,6 +280,7 @@ fn local_fits(psd: &Psd, locals: &[raw::Local], kind: SignalKind, slots: &mut Ve
             sweep_end_hz: None,
             stationary: false,
             rough_below_hz: 0.0,
+            residual_standing_db: model::SPECTRUM_STANDING_DB,
         };
         let seed = Seed {
             frequency_hz: l.half.estimate.frequency_hz,
@@ -595,6 +596,11 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         rough_below_hz: result
             .sweep
             .map_or(0.0, |s| 4.0 * s.rate_at(s.band_hz[0]).sqrt()),
+        residual_standing_db: if result.sweep.is_some() {
+            model::RESIDUAL_STANDING_DB
+        } else {
+            model::SPECTRUM_STANDING_DB
+        },
     };
     // A response rising into a sweep's end: as for a spectrum file's cliff
     // (`identify_spectrum`), a mode seeded past the band, reported as cut off unless the fit
@@ -718,6 +724,7 @@ pub fn identify_spectrum(
         sweep_end_hz: end.map(|e| spectrum::end_hz(&grid, e)),
         stationary: false,
         rough_below_hz: 0.0,
+        residual_standing_db: model::SPECTRUM_STANDING_DB,
     };
     // A response still rising into the sweep's end: fitted with a mode seeded past the band
     // (its flank would otherwise be read as modes under the cliff), and reported as cut off
