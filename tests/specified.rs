@@ -425,6 +425,23 @@ fn bad_parameters_name_their_field() {
             },
             "vtol",
         ),
+        // subnormal: no finite reciprocal (the solver never returned, 2026-12-06)
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                vtol: 1e-310,
+                ..Default::default()
+            },
+            "vtol",
+        ),
+        (
+            SiSpec {
+                insensitivity: Some(0.5),
+                vtol_profile: Some(vec![[1.0, 0.05], [2.0, 1e-310]]),
+                ..Default::default()
+            },
+            "vtolProfile[1][1]",
+        ),
         (
             SiSpec {
                 insensitivity: Some(0.5),

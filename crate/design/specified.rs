@@ -183,7 +183,10 @@ fn tolerance(spec: &SiSpec) -> Result<Tolerance> {
                     ),
                 ));
             }
-            Tolerance::constant(spec.vtol)?
+            Tolerance::constant(spec.vtol).map_err(|e| match e {
+                Error::InvalidInput { reason, .. } => Error::invalid("vtol", reason),
+                other => other,
+            })?
         }
     })
 }

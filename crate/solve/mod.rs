@@ -78,7 +78,8 @@ impl Tolerance {
     }
 
     /// Vtol linear between the given `(frequency in Hz, Vtol)` points (sorted by frequency,
-    /// distinct), constant outside them. Each Vtol must lie in (0, 1).
+    /// distinct), constant outside them. Each Vtol must lie in (0, 1) and be a normal number
+    /// (at least 2.2·10⁻³⁰⁸).
     pub fn profile(points: Vec<(f64, f64)>) -> Result<Self> {
         if points.is_empty() {
             return Err(Error::invalid("vtolProfile", "give at least one point"));
@@ -93,10 +94,13 @@ impl Tolerance {
                     format!("frequency must be ≥ 0 Hz, got {f}"),
                 ));
             }
-            if !(v > 0.0 && v < 1.0) {
+            if !tolerable(v) {
                 return Err(Error::invalid(
                     format!("vtolProfile[{i}][1]"),
-                    format!("tolerable vibration must lie in (0, 1), got {v}"),
+                    format!(
+                        "tolerable vibration must lie in (0, 1), got {v}{}",
+                        subnormal(v)
+                    ),
                 ));
             }
             if i > 0 && f <= points[i - 1].0 {
@@ -138,6 +142,23 @@ impl Tolerance {
 
     fn scaled(&self, f_ref: f64) -> Vec<(f64, f64)> {
         self.points.iter().map(|&(f, v)| (f / f_ref, v)).collect()
+    }
+}
+
+/// A tolerable vibration the solver can work with: in (0, 1) and a normal number. A subnormal
+/// one (under 2.2·10⁻³⁰⁸) has no finite reciprocal, and the constraints scaled by it were
+/// infinite: `minimum_duration` never returned (the 10⁶-case property run, 2026-12-06:
+/// Vtol 10⁻³¹⁰ at one sample; 10⁻³⁰⁰ ends at once as infeasible).
+fn tolerable(v: f64) -> bool {
+    (f64::MIN_POSITIVE..1.0).contains(&v)
+}
+
+/// The reason a positive Vtol was refused, if it was for being subnormal.
+fn subnormal(v: f64) -> &'static str {
+    if v > 0.0 && v < f64::MIN_POSITIVE {
+        " (a subnormal number: give at least 2.2e-308)"
+    } else {
+        ""
     }
 }
 
@@ -444,10 +465,10 @@ fn frequency_span(p: &Problem) -> Result<(f64, f64)> {
     for l in &p.limits {
         check_frequency("sampleFrequenciesHz", l.frequency_hz)?;
         check_damping("damping", l.damping)?;
-        if !(l.vtol > 0.0 && l.vtol < 1.0) {
+        if !tolerable(l.vtol) {
             return Err(Error::invalid(
                 "vtol",
-                format!("must lie in (0, 1), got {}", l.vtol),
+                format!("must lie in (0, 1), got {}{}", l.vtol, subnormal(l.vtol)),
             ));
         }
         f_ref = f_ref.max(l.frequency_hz);
