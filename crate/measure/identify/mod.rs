@@ -532,6 +532,14 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
         // A sweep's band with no peak: no mode to read there, and the Welch path, not meant
         // for sweeps, would read its lumps as modes.
         result.sweep = sweep;
+        if s.partial {
+            result.notes.push(format!(
+                "The sweep stands over the sensor's noise only over {:.1}–{:.1} Hz of the \
+                 record: modes outside that band cannot be read from it (a stronger drive or \
+                 a quieter sensor would show them).",
+                s.band_hz[0], s.band_hz[1]
+            ));
+        }
         if stage.is_none() {
             let law = match s.law {
                 SweepLaw::Linear => "",

@@ -60,6 +60,10 @@ pub struct Sweep {
     pub rate_hz_per_s: f64,
     /// Linear or exponential.
     pub law: SweepLaw,
+    /// Seen over part of the record only, the rest under the sensor's noise (see
+    /// `Reading::Part`): below the band there is nothing but noise to read.
+    #[serde(skip)]
+    pub(crate) partial: bool,
 }
 
 impl Sweep {
@@ -226,16 +230,35 @@ fn line(points: &[(f64, f64)]) -> Option<(f64, f64)> {
 /// line through them must span 4 of them (8 of the first frames' bins): 15 Hz swept in
 /// 1.7 s spans 4.9 bins of the 0.32 s frames that record holds 18 of.
 pub(super) fn detect_sweep(signal: &[f64], fs: f64) -> Option<Sweep> {
+    detect_with(signal, fs, Reading::Whole).or_else(|| detect_with(signal, fs, Reading::Part))
+}
+
+/// How much of the record a sweep must be seen over (see [`Reading`] and `detect_sweep`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Reading {
+    /// The line holds for most frames of the record (Theil–Sen through all of them).
+    Whole,
+    /// A sweep seen over part of the record only, the rest of its frames noise: the drive
+    /// under the sensor's noise until it nears a mode (a low-pass plant swept from 5 Hz with
+    /// the drive ∝ f: 0–3.5 s of a 6.1 s logarithmic sweep to 116 Hz read noise, and the
+    /// frames past a sharp mode its ringing; benches/reference/sweep_chirps.py, seed 3). Tried
+    /// only when the whole reading finds no sweep at any frame length (its finds stay as they
+    /// were), with a line of consensus ([`consensus_line`]) held densely by at least a
+    /// quarter of the frames.
+    Part,
+}
+
+fn detect_with(signal: &[f64], fs: f64, reading: Reading) -> Option<Sweep> {
     let first = (fs.round() as usize).next_power_of_two().clamp(64, 1 << 16);
     let last = ((fs / 16.0).round() as usize).next_power_of_two().max(64);
     let mut len = first;
     loop {
         if signal.len() >= 4 * len {
             let span_bins = if len == first { 8.0 } else { 4.0 };
-            if let Some(s) = sweep_with_frames(signal, fs, len, span_bins) {
+            if let Some(s) = sweep_with_frames(signal, fs, len, span_bins, reading) {
                 return Some(match s.law {
                     SweepLaw::Linear => s,
-                    SweepLaw::Exponential => exponential_top(signal, fs, len, last, s),
+                    SweepLaw::Exponential => exponential_top(signal, fs, len, last, s, reading),
                 });
             }
         }
@@ -252,12 +275,19 @@ pub(super) fn detect_sweep(signal: &[f64], fs: f64) -> Option<Sweep> {
 /// a 1.3 s frame, whose strongest bin then lies well under the sweep: the band ended at
 /// 220 Hz), and halving the frame halves the smear. The highest top of those that find the
 /// same law at the same growth (within 15 %) is kept; the start stays the long frames'.
-fn exponential_top(signal: &[f64], fs: f64, len: usize, last: usize, found: Sweep) -> Sweep {
+fn exponential_top(
+    signal: &[f64],
+    fs: f64,
+    len: usize,
+    last: usize,
+    found: Sweep,
+    reading: Reading,
+) -> Sweep {
     let growth = |s: &Sweep| s.rate_hz_per_s / (s.band_hz[0] * s.band_hz[1]).sqrt();
     let mut out = found;
     let mut shorter = len / 2;
     while shorter >= last && signal.len() >= 4 * shorter {
-        if let Some(s) = sweep_with_frames(signal, fs, shorter, 4.0) {
+        if let Some(s) = sweep_with_frames(signal, fs, shorter, 4.0, reading) {
             if s.law == SweepLaw::Exponential
                 && (growth(&s) / growth(&found) - 1.0).abs() <= 0.15
                 && s.band_hz[1] > out.band_hz[1]
@@ -273,8 +303,16 @@ fn exponential_top(signal: &[f64], fs: f64, len: usize, last: usize, found: Swee
 
 /// The sweep as frames of `len` samples see it, spanning at least `span_bins` of their bins
 /// (see `detect_sweep`): the law whose line holds for more frames, linear on a tie (a narrow
-/// exponential sweep is nearly linear, and either reads it).
-fn sweep_with_frames(signal: &[f64], fs: f64, len: usize, span_bins: f64) -> Option<Sweep> {
+/// exponential sweep is nearly linear, and either reads it). Read whole, the line must hold
+/// for 60 % of the frames; read in part, for a quarter of them and 60 % of those between its
+/// first and last.
+fn sweep_with_frames(
+    signal: &[f64],
+    fs: f64,
+    len: usize,
+    span_bins: f64,
+    reading: Reading,
+) -> Option<Sweep> {
     let frames = ridge(signal, fs, len);
     let n = frames.len();
     if n < 8 {
@@ -282,22 +320,45 @@ fn sweep_with_frames(signal: &[f64], fs: f64, len: usize, span_bins: f64) -> Opt
     }
     let bin = fs / len as f64;
     let frame_s = len as f64 / fs;
-    let linear = law_line(&frames, SweepLaw::Linear, bin, frame_s);
-    let exponential = law_line(&frames, SweepLaw::Exponential, bin, frame_s);
+    let fit_law = |law| match reading {
+        Reading::Whole => law_line(&frames, law, bin, frame_s),
+        Reading::Part => consensus_line(&frames, law, bin, frame_s),
+    };
+    let linear = fit_law(SweepLaw::Linear);
+    let exponential = fit_law(SweepLaw::Exponential);
     let held = |l: &Option<LawLine>| l.as_ref().map_or(0, |l| l.within_two_bins);
     let (law, fit) = if held(&exponential) > held(&linear) + (n / 20).max(1) {
         (SweepLaw::Exponential, exponential?)
     } else {
         (SweepLaw::Linear, linear?)
     };
-    if fit.inliers < 8 || (fit.inliers as f64) < 0.6 * n as f64 {
+    let held_enough = match reading {
+        Reading::Whole => fit.inliers as f64 >= 0.6 * n as f64,
+        Reading::Part => {
+            let between = frames
+                .iter()
+                .filter(|f| f.0 >= fit.first_s && f.0 <= fit.last_s)
+                .count();
+            4 * fit.inliers >= n && fit.inliers as f64 >= 0.6 * between as f64
+        }
+    };
+    if fit.inliers < 8 || !held_enough {
         return None;
     }
     // The line over the inlying frames, widened by half a frame's worth of sweep at each end.
+    // A sweep seen in part goes on past its last frame over the noise while the record does
+    // (a sharp mode's ringing, then the response under the noise: a low-pass plant past its
+    // mode), up to as long again as it was seen: its band reaches past the mode it found.
     let half_frame = 0.5 * len as f64 / fs;
+    let last_s = match reading {
+        Reading::Whole => fit.last_s,
+        Reading::Part => frames.last().map_or(fit.last_s, |f| {
+            f.0.clamp(fit.last_s, 2.0 * fit.last_s - fit.first_s)
+        }),
+    };
     let (ga, gb) = (
         fit.intercept + fit.slope * fit.first_s,
-        fit.intercept + fit.slope * fit.last_s,
+        fit.intercept + fit.slope * last_s,
     );
     let widen = (half_frame * fit.slope).abs();
     let (lo, hi) = (ga.min(gb) - widen, ga.max(gb) + widen);
@@ -305,6 +366,7 @@ fn sweep_with_frames(signal: &[f64], fs: f64, len: usize, span_bins: f64) -> Opt
         SweepLaw::Linear => [lo, hi],
         SweepLaw::Exponential => [lo.exp(), hi.exp()],
     };
+    let band = [band[0], band[1].min(0.45 * fs)];
     if band[1] - band[0] < span_bins * bin || band[0] <= 0.0 {
         return None;
     }
@@ -316,6 +378,7 @@ fn sweep_with_frames(signal: &[f64], fs: f64, len: usize, span_bins: f64) -> Opt
         band_hz: band,
         rate_hz_per_s: rate,
         law,
+        partial: reading == Reading::Part,
     })
 }
 
@@ -395,6 +458,91 @@ fn law_line(frames: &[(f64, f64)], law: SweepLaw, bin: f64, frame_s: f64) -> Opt
         within_two_bins: strict.len(),
         first_s: near.iter().map(|p| p.0).fold(f64::INFINITY, f64::min),
         last_s: near.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max),
+    })
+}
+
+/// The law's line held by the most frames, for a sweep seen over part of the record
+/// ([`Reading::Part`]): Theil–Sen breaks down when most frames are noise (its median slope is
+/// the noise's), so candidate lines are drawn through pairs of frames near in time (2, 4 and 8
+/// hops apart, from at most 300 evenly spread first frames), each scored by the frames within
+/// two bins of it (plus the exponential law's smear, as [`law_line`]). The best one's inliers
+/// are split where two follow each other more than half a frame apart (one frame of the
+/// quarter hop missed), the largest run is kept (noise frames that fall near the line's
+/// extension are not the sweep: with a frame's length a 1 kHz recording's band reached down
+/// to 12.5 Hz from a sweep seen from 22 Hz), and the line
+/// is fitted to it by least squares and its frames counted again.
+fn consensus_line(frames: &[(f64, f64)], law: SweepLaw, bin: f64, frame_s: f64) -> Option<LawLine> {
+    type Map = fn(f64) -> f64;
+    let (g, inverse): (Map, Map) = match law {
+        SweepLaw::Linear => (|f| f, |g| g),
+        SweepLaw::Exponential => (f64::ln, f64::exp),
+    };
+    let mapped: Vec<(f64, f64)> = frames
+        .iter()
+        .filter(|p| p.1 > 0.0)
+        .map(|p| (p.0, g(p.1)))
+        .collect();
+    let n = mapped.len();
+    if n < 8 {
+        return None;
+    }
+    let near = |b: f64, r: f64, p: &(f64, f64), smear_of: f64| {
+        let f = inverse(b + r * p.0);
+        let smear = match law {
+            SweepLaw::Linear => 0.0,
+            SweepLaw::Exponential => 0.25 * smear_of.abs() * frame_s,
+        };
+        (inverse(p.1) - f).abs() <= 2.0 * bin + smear * f
+    };
+    let mut best: Option<(usize, f64, f64)> = None;
+    for i in (0..n).step_by(n.div_ceil(300)) {
+        for d in [2, 4, 8] {
+            let Some(q) = mapped.get(i + d) else { continue };
+            let p = mapped[i];
+            if q.0 <= p.0 {
+                continue;
+            }
+            let r = (q.1 - p.1) / (q.0 - p.0);
+            let b = p.1 - r * p.0;
+            let count = mapped.iter().filter(|m| near(b, r, m, r)).count();
+            if best.is_none_or(|(c, _, _)| count > c) {
+                best = Some((count, b, r));
+            }
+        }
+    }
+    let (_, b, r) = best?;
+    let inliers: Vec<(f64, f64)> = mapped
+        .iter()
+        .copied()
+        .filter(|m| near(b, r, m, r))
+        .collect();
+    // The largest run of inliers with no gap longer than a frame.
+    let mut runs: Vec<&[(f64, f64)]> = Vec::new();
+    let mut start = 0;
+    for k in 1..=inliers.len() {
+        if k == inliers.len() || inliers[k].0 - inliers[k - 1].0 > 0.5 * frame_s + 1e-9 {
+            runs.push(&inliers[start..k]);
+            start = k;
+        }
+    }
+    let run = runs.into_iter().max_by_key(|r| r.len())?;
+    let (intercept, slope) = line(run)?;
+    let (t0, t1) = (run[0].0, run[run.len() - 1].0);
+    let within: Vec<&(f64, f64)> = mapped
+        .iter()
+        .filter(|m| m.0 >= t0 && m.0 <= t1 && near(intercept, slope, m, slope))
+        .collect();
+    let strict = within
+        .iter()
+        .filter(|m| (inverse(m.1) - inverse(intercept + slope * m.0)).abs() <= 2.0 * bin)
+        .count();
+    Some(LawLine {
+        intercept,
+        slope,
+        inliers: within.len(),
+        within_two_bins: strict,
+        first_s: t0,
+        last_s: t1,
     })
 }
 
