@@ -518,6 +518,16 @@ fn bad_parameters_name_their_field() {
         let err = design(&spec.clone().request(mode(1.0, 0.0))).unwrap_err();
         assert_eq!(err.field(), Some(field), "{spec:?}: {err}");
     }
+    // A subnormal Vtol is shown as it was given, with the reason.
+    let tiny = SiSpec {
+        insensitivity: Some(0.5),
+        vtol: 1e-310,
+        ..Default::default()
+    };
+    let err = design(&tiny.request(mode(1.0, 0.0)))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("got 1e-310 (a subnormal number"), "{err}");
     // bandHz is one band: not with several modes.
     let two = vec![
         ModeSpec {

@@ -97,10 +97,7 @@ impl Tolerance {
             if !tolerable(v) {
                 return Err(Error::invalid(
                     format!("vtolProfile[{i}][1]"),
-                    format!(
-                        "tolerable vibration must lie in (0, 1), got {v}{}",
-                        subnormal(v)
-                    ),
+                    format!("tolerable vibration must lie in (0, 1), got {}", shown(v)),
                 ));
             }
             if i > 0 && f <= points[i - 1].0 {
@@ -153,12 +150,12 @@ fn tolerable(v: f64) -> bool {
     (f64::MIN_POSITIVE..1.0).contains(&v)
 }
 
-/// The reason a positive Vtol was refused, if it was for being subnormal.
-fn subnormal(v: f64) -> &'static str {
+/// A refused Vtol as the error shows it: a subnormal one in e-notation, with the reason.
+fn shown(v: f64) -> String {
     if v > 0.0 && v < f64::MIN_POSITIVE {
-        " (a subnormal number: give at least 2.2e-308)"
+        format!("{v:e} (a subnormal number: give at least 2.2e-308)")
     } else {
-        ""
+        format!("{v}")
     }
 }
 
@@ -468,7 +465,7 @@ fn frequency_span(p: &Problem) -> Result<(f64, f64)> {
         if !tolerable(l.vtol) {
             return Err(Error::invalid(
                 "vtol",
-                format!("must lie in (0, 1), got {}{}", l.vtol, subnormal(l.vtol)),
+                format!("must lie in (0, 1), got {}", shown(l.vtol)),
             ));
         }
         f_ref = f_ref.max(l.frequency_hz);
