@@ -166,8 +166,8 @@ pub fn impulse_phasor(time: f64, t_n: f64, omega: f64, zeta: f64) -> [f64; 2] {
 /// and a `sin_cos`.
 #[inline]
 fn term(amplitude: f64, time: f64, t_n: f64, omega: f64, zeta: f64, damped: f64) -> (f64, f64) {
-    let w = amplitude * (-(zeta * omega) * (t_n - time)).exp();
-    let (sin, cos) = (omega * damped * time).sin_cos();
+    let [decay, sin, cos] = moment_factor(time, t_n, omega, zeta, damped);
+    let w = amplitude * decay;
     (w * cos, w * sin)
 }
 

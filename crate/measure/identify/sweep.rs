@@ -349,7 +349,6 @@ fn sweep_with_frames(
     // A sweep seen in part goes on past its last frame over the noise while the record does
     // (a sharp mode's ringing, then the response under the noise: a low-pass plant past its
     // mode), up to as long again as it was seen: its band reaches past the mode it found.
-    let half_frame = 0.5 * len as f64 / fs;
     let last_s = match reading {
         Reading::Whole => fit.last_s,
         Reading::Part => frames.last().map_or(fit.last_s, |f| {
@@ -360,7 +359,7 @@ fn sweep_with_frames(
         fit.intercept + fit.slope * fit.first_s,
         fit.intercept + fit.slope * last_s,
     );
-    let widen = (half_frame * fit.slope).abs();
+    let widen = (0.5 * frame_s * fit.slope).abs();
     let (lo, hi) = (ga.min(gb) - widen, ga.max(gb) + widen);
     let band = match law {
         SweepLaw::Linear => [lo, hi],
