@@ -674,6 +674,20 @@ mod tests {
         assert_eq!(slow_sweep_comb(&periodogram(&x, fs).unwrap()), None);
     }
 
+    /// A 5 s record's periodogram at 1 kHz (one rectangular segment) of the given bins.
+    fn periodogram_of(frequency_hz: Vec<f64>, psd: Vec<f64>, df: f64) -> Psd {
+        Psd {
+            frequency_hz,
+            psd,
+            segment_length: 5000,
+            overlap: 0,
+            segments: 1,
+            resolution_hz: df,
+            enbw_bins: 1.0,
+            sample_rate_hz: 1000.0,
+        }
+    }
+
     /// A periodogram of 0.2 Hz bins: a floor of 1, the sweep's band (from `start` Hz to 86 Hz)
     /// at 100·(f/50)², and narrow resonances (frequency, ζ) 30 times their surroundings.
     fn sweep_psd(start: f64, peaks: &[(f64, f64)]) -> Psd {
@@ -698,16 +712,7 @@ mod tests {
                 base * (1.0 + lift)
             })
             .collect();
-        Psd {
-            frequency_hz,
-            psd,
-            segment_length: 5000,
-            overlap: 0,
-            segments: 1,
-            resolution_hz: df,
-            enbw_bins: 1.0,
-            sample_rate_hz: 1000.0,
-        }
+        periodogram_of(frequency_hz, psd, df)
     }
 
     /// A peak far under a sweep's start is not one of its start's peaks (nothing is excited
@@ -768,16 +773,7 @@ mod tests {
                 }
             })
             .collect();
-        let psd = Psd {
-            frequency_hz,
-            psd,
-            segment_length: 5000,
-            overlap: 0,
-            segments: 1,
-            resolution_hz: df,
-            enbw_bins: 1.0,
-            sample_rate_hz: 1000.0,
-        };
+        let psd = periodogram_of(frequency_hz, psd, df);
         let mut sweep = Sweep {
             band_hz: [25.0, 86.0],
             rate_hz_per_s: 24.0,

@@ -402,17 +402,26 @@ struct LawLine {
     last_s: f64,
 }
 
-fn law_line(frames: &[(f64, f64)], law: SweepLaw, bin: f64, frame_s: f64) -> Option<LawLine> {
-    type Map = fn(f64) -> f64;
+/// A law's map of frequency (identity or ln), or its inverse.
+type Map = fn(f64) -> f64;
+
+/// The frames (time, g(f)) with g the law's map (identity or ln), frames without a positive
+/// frequency left out, and the map's inverse.
+fn mapped_frames(frames: &[(f64, f64)], law: SweepLaw) -> (Vec<(f64, f64)>, Map) {
     let (g, inverse): (Map, Map) = match law {
         SweepLaw::Linear => (|f| f, |g| g),
         SweepLaw::Exponential => (f64::ln, f64::exp),
     };
-    let mapped: Vec<(f64, f64)> = frames
+    let mapped = frames
         .iter()
         .filter(|p| p.1 > 0.0)
         .map(|p| (p.0, g(p.1)))
         .collect();
+    (mapped, inverse)
+}
+
+fn law_line(frames: &[(f64, f64)], law: SweepLaw, bin: f64, frame_s: f64) -> Option<LawLine> {
+    let (mapped, inverse) = mapped_frames(frames, law);
     let n = mapped.len();
     if n < 2 {
         return None;
@@ -471,16 +480,7 @@ fn law_line(frames: &[(f64, f64)], law: SweepLaw, bin: f64, frame_s: f64) -> Opt
 /// to 12.5 Hz from a sweep seen from 22 Hz), and the line
 /// is fitted to it by least squares and its frames counted again.
 fn consensus_line(frames: &[(f64, f64)], law: SweepLaw, bin: f64, frame_s: f64) -> Option<LawLine> {
-    type Map = fn(f64) -> f64;
-    let (g, inverse): (Map, Map) = match law {
-        SweepLaw::Linear => (|f| f, |g| g),
-        SweepLaw::Exponential => (f64::ln, f64::exp),
-    };
-    let mapped: Vec<(f64, f64)> = frames
-        .iter()
-        .filter(|p| p.1 > 0.0)
-        .map(|p| (p.0, g(p.1)))
-        .collect();
+    let (mapped, inverse) = mapped_frames(frames, law);
     let n = mapped.len();
     if n < 8 {
         return None;
