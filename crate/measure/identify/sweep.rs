@@ -230,7 +230,33 @@ fn line(points: &[(f64, f64)]) -> Option<(f64, f64)> {
 /// line through them must span 4 of them (8 of the first frames' bins): 15 Hz swept in
 /// 1.7 s spans 4.9 bins of the 0.32 s frames that record holds 18 of.
 pub(super) fn detect_sweep(signal: &[f64], fs: f64) -> Option<Sweep> {
-    detect_with(signal, fs, Reading::Whole).or_else(|| detect_with(signal, fs, Reading::Part))
+    let mut ridges = Ridges {
+        signal,
+        fs,
+        kept: Vec::new(),
+    };
+    detect_with(&mut ridges, Reading::Whole).or_else(|| detect_with(&mut ridges, Reading::Part))
+}
+
+/// Each frame length's ridge ([`ridge`]), computed once for both readings (a recording that
+/// is no sweep is read twice at every length: its frames' FFTs were most of that).
+struct Ridges<'a> {
+    signal: &'a [f64],
+    fs: f64,
+    kept: Vec<(usize, Vec<(f64, f64)>)>,
+}
+
+impl Ridges<'_> {
+    fn frames(&mut self, len: usize) -> &[(f64, f64)] {
+        let at = match self.kept.iter().position(|(l, _)| *l == len) {
+            Some(i) => i,
+            None => {
+                self.kept.push((len, ridge(self.signal, self.fs, len)));
+                self.kept.len() - 1
+            }
+        };
+        &self.kept[at].1
+    }
 }
 
 /// How much of the record a sweep must be seen over (see [`Reading`] and `detect_sweep`).
@@ -248,17 +274,18 @@ enum Reading {
     Part,
 }
 
-fn detect_with(signal: &[f64], fs: f64, reading: Reading) -> Option<Sweep> {
+fn detect_with(ridges: &mut Ridges, reading: Reading) -> Option<Sweep> {
+    let (signal, fs) = (ridges.signal, ridges.fs);
     let first = (fs.round() as usize).next_power_of_two().clamp(64, 1 << 16);
     let last = ((fs / 16.0).round() as usize).next_power_of_two().max(64);
     let mut len = first;
     loop {
         if signal.len() >= 4 * len {
             let span_bins = if len == first { 8.0 } else { 4.0 };
-            if let Some(s) = sweep_with_frames(signal, fs, len, span_bins, reading) {
+            if let Some(s) = sweep_with_frames(ridges, len, span_bins, reading) {
                 return Some(match s.law {
                     SweepLaw::Linear => s,
-                    SweepLaw::Exponential => exponential_top(signal, fs, len, last, s, reading),
+                    SweepLaw::Exponential => exponential_top(ridges, len, last, s, reading),
                 });
             }
         }
@@ -276,8 +303,7 @@ fn detect_with(signal: &[f64], fs: f64, reading: Reading) -> Option<Sweep> {
 /// 220 Hz), and halving the frame halves the smear. The highest top of those that find the
 /// same law at the same growth (within 15 %) is kept; the start stays the long frames'.
 fn exponential_top(
-    signal: &[f64],
-    fs: f64,
+    ridges: &mut Ridges,
     len: usize,
     last: usize,
     found: Sweep,
@@ -286,8 +312,8 @@ fn exponential_top(
     let growth = |s: &Sweep| s.rate_hz_per_s / (s.band_hz[0] * s.band_hz[1]).sqrt();
     let mut out = found;
     let mut shorter = len / 2;
-    while shorter >= last && signal.len() >= 4 * shorter {
-        if let Some(s) = sweep_with_frames(signal, fs, shorter, 4.0, reading) {
+    while shorter >= last && ridges.signal.len() >= 4 * shorter {
+        if let Some(s) = sweep_with_frames(ridges, shorter, 4.0, reading) {
             if s.law == SweepLaw::Exponential
                 && (growth(&s) / growth(&found) - 1.0).abs() <= 0.15
                 && s.band_hz[1] > out.band_hz[1]
@@ -307,13 +333,13 @@ fn exponential_top(
 /// for 60 % of the frames; read in part, for a quarter of them and 60 % of those between its
 /// first and last.
 fn sweep_with_frames(
-    signal: &[f64],
-    fs: f64,
+    ridges: &mut Ridges,
     len: usize,
     span_bins: f64,
     reading: Reading,
 ) -> Option<Sweep> {
-    let frames = ridge(signal, fs, len);
+    let fs = ridges.fs;
+    let frames = ridges.frames(len);
     let n = frames.len();
     if n < 8 {
         return None;
@@ -321,8 +347,8 @@ fn sweep_with_frames(
     let bin = fs / len as f64;
     let frame_s = len as f64 / fs;
     let fit_law = |law| match reading {
-        Reading::Whole => law_line(&frames, law, bin, frame_s),
-        Reading::Part => consensus_line(&frames, law, bin, frame_s),
+        Reading::Whole => law_line(frames, law, bin, frame_s),
+        Reading::Part => consensus_line(frames, law, bin, frame_s),
     };
     let linear = fit_law(SweepLaw::Linear);
     let exponential = fit_law(SweepLaw::Exponential);
