@@ -266,3 +266,32 @@ fn rows_rounded_off_a_bin_spacing_under_a_tenth_are_read() {
     assert!((m.frequency_hz / fn_hz - 1.0).abs() < 0.01, "{m:?}");
     assert!((m.damping / zeta - 1.0).abs() < 0.15, "{m:?}");
 }
+
+/// Klipper writes its spectrum headers in lower case; another tool's `Freq,PSD_X,…` (and a
+/// `Shapers:` marker) is read the same, not refused as a recording without a time column.
+#[wasm_bindgen_test(unsupported = test)]
+fn spectrum_headers_are_read_whatever_their_case() {
+    let lower = spectrum(RESONANCES, "resonances_x_a.csv");
+    let upper = spectrum(
+        &RESONANCES.replacen(
+            "freq,psd_x,psd_y,psd_z,psd_xyz",
+            "Freq,PSD_X,PSD_Y,PSD_Z,PSD_XYZ",
+            1,
+        ),
+        "resonances_x_a.csv",
+    );
+    assert_eq!(upper.format, RecordingFormat::KlipperResonances);
+    assert_eq!(
+        (&upper.frequency_hz, &upper.psd, &upper.psd_y),
+        (&lower.frequency_hz, &lower.psd, &lower.psd_y)
+    );
+    let calibration = "FREQ,PSD_X,PSD_Y,PSD_Z,PSD_XYZ,Shapers:,mzv(52.4)\n\
+0.0,1.0,2.0,3.0,6.0,,0.5\n\
+1.6,4.0,5.0,6.0,15.0,,0.4\n\
+3.1,7.0,8.0,9.0,24.0,,0.3\n\
+4.7,10.0,11.0,12.0,33.0,,0.2\n";
+    let c = spectrum(calibration, "calibration_data_x_a.csv");
+    assert_eq!(c.format, RecordingFormat::KlipperCalibration);
+    assert_eq!(c.shapers.len(), 1);
+    assert_eq!(c.psd, vec![6.0, 15.0, 24.0, 33.0]);
+}

@@ -669,11 +669,15 @@ impl RecordingParser {
             && names[..5]
                 .iter()
                 .zip(["freq", "psd_x", "psd_y", "psd_z", "psd_xyz"])
-                .all(|(a, b)| a == b)
+                .all(|(a, b)| a.eq_ignore_ascii_case(b))
         {
             return self.spectrum_header(names, separator);
         }
-        if names.first().map(|s| s.as_str()) == Some("freq") && names.len() >= 2 {
+        if names
+            .first()
+            .is_some_and(|s| s.eq_ignore_ascii_case("freq"))
+            && names.len() >= 2
+        {
             // Klipper's current `save_calibration_data` with several runs: one `psd_xyz`
             // column per run, named after it.
             return self.spectrum_header(names, separator);
@@ -757,8 +761,13 @@ impl RecordingParser {
             e.too_large = Some((names.len() as f64, MAX_COLUMNS as f64));
             return Err(e);
         }
-        let marker = names.iter().position(|s| s == "shapers:");
-        let runs = names.get(1).map(String::as_str) != Some("psd_x");
+        // Klipper writes the names in lower case; other tools' `Freq,PSD_X,…` read the same.
+        let marker = names
+            .iter()
+            .position(|s| s.eq_ignore_ascii_case("shapers:"));
+        let runs = !names
+            .get(1)
+            .is_some_and(|s| s.eq_ignore_ascii_case("psd_x"));
         let first_extra = if runs { 1 } else { 5 };
         // Klipper's releases before the `shapers:` marker (2021–2023, `save_calibration_data`
         // writing `freq,psd_x,psd_y,psd_z,psd_xyz,zv(61.6),mzv(62.6),…`): the trailing columns
