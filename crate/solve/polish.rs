@@ -422,6 +422,21 @@ fn log_slope(
     }
 }
 
+/// The singular value decomposition of `m` (U and Vᵀ computed), or `None` when it has a NaN or
+/// an infinity or does not converge within a budget of iterations: nalgebra's `svd` iterates
+/// until it converges, and on a matrix with a NaN it never does — a design request of the
+/// 10⁶-case property run spun there for hours (docs/testing.md). Same tolerance as `svd`
+/// (5 ε), so the same decomposition wherever that one ends.
+fn bounded_svd(
+    m: DMatrix<f64>,
+) -> Option<nalgebra::linalg::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>> {
+    if m.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let budget = 1000 + 100 * m.nrows().max(m.ncols());
+    m.try_svd(true, true, 5.0 * f64::EPSILON, budget)
+}
+
 /// Result of the inner solve: y and the multipliers of c.
 struct Solved {
     y: Vec<f64>,
@@ -444,7 +459,7 @@ struct Linearization {
 impl Linearization {
     fn new(jac: DMatrix<f64>, grad_f: &DVector<f64>) -> Option<Self> {
         let n = jac.ncols();
-        let svd = jac.svd(true, true);
+        let svd = bounded_svd(jac)?;
         let (u, vt) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
         let smax = svd.singular_values.iter().fold(0.0_f64, |a, &b| a.max(b));
         let cut = 1e-10 * smax.max(1e-300);
@@ -627,8 +642,15 @@ fn null_space_step(
     } else {
         reduced_hessian(y, &lin.null, &lag)
     };
-    // Positive definite (a minimum, not a saddle): eigenvalues by magnitude, floored.
-    let eig = hz.symmetric_eigen();
+    // Positive definite (a minimum, not a saddle): eigenvalues by magnitude, floored. No step
+    // when the Hessian is not finite (its eigen-decomposition would never end: `bounded_svd`).
+    if hz.iter().any(|v| !v.is_finite()) {
+        return DVector::zeros(setup.n);
+    }
+    let budget = 1000 + 100 * hz.nrows();
+    let Some(eig) = hz.try_symmetric_eigen(f64::EPSILON, budget) else {
+        return DVector::zeros(setup.n);
+    };
     let emax = eig
         .eigenvalues
         .iter()
@@ -1294,7 +1316,9 @@ pub(crate) fn project_equalities(norm: &NormalizedProblem, impulses: &mut [Impul
     let e = DMatrix::from_fn(rows.len(), n, |r, c| rows[r][c]);
     let a = DVector::from_iterator(n, impulses.iter().map(|i| i.amplitude));
     let residual = DVector::from_vec(rhs) - &e * &a;
-    let svd = (&e * e.transpose()).svd(true, true);
+    let Some(svd) = bounded_svd(&e * e.transpose()) else {
+        return;
+    };
     if let Ok(w) = svd.solve(&residual, 1e-12) {
         let delta = e.transpose() * w;
         for (imp, d) in impulses.iter_mut().zip(delta.iter()) {
@@ -1306,6 +1330,25 @@ pub(crate) fn project_equalities(norm: &NormalizedProblem, impulses: &mut [Impul
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A matrix with a NaN or an infinity has no decomposition (nalgebra's own `svd` and
+    /// `symmetric_eigen` never return on it), and a finite one gets nalgebra's own, bit for bit.
+    #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
+    fn decompositions_end_on_any_matrix() {
+        let m = DMatrix::from_fn(5, 7, |r, c| {
+            ((r * 7 + c) as f64 * 0.37).sin() + 0.1 * r as f64
+        });
+        let ours = bounded_svd(m.clone()).expect("a finite matrix");
+        let theirs = m.clone().svd(true, true);
+        assert_eq!(ours.singular_values, theirs.singular_values);
+        assert_eq!(ours.u, theirs.u);
+        assert_eq!(ours.v_t, theirs.v_t);
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let mut b = m.clone();
+            b[(2, 3)] = bad;
+            assert!(bounded_svd(b).is_none(), "{bad}");
+        }
+    }
 
     /// A smooth non-quadratic test function with a closed-form Hessian:
     /// f(y) = e^{y₀} sin(y₁) + y₀² y₂ + cos(y₁ y₂).
