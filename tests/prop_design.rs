@@ -132,6 +132,9 @@ fn check_guarantee(
 }
 
 fn run_design(request: &DesignRequest) -> Result<(), TestCaseError> {
+    if std::env::var("PROP_TRACE").is_ok() {
+        eprintln!("request: {request:?}");
+    }
     match design(request) {
         Ok(shaper) => {
             if let Err(why) = check_valid(&shaper) {

@@ -637,3 +637,29 @@ fn four_modes_amplitudes_sum_to_one() {
         assert!(worst <= vtol * (1.0 + 1e-6), "V = {worst} on {lo}…{hi} Hz");
     }
 }
+
+/// A request of the 10⁶-case property run (`any_request_is_ok_and_valid_or_a_typed_error`,
+/// `PROPTEST_RNG_SEED=7`, 2026-12-06) on which `design` never returned: `si` over a band with
+/// a Vtol profile down to 2.2·10⁻³⁰⁸ (the smallest normal number, so not refused as subnormal)
+/// for a 30 Hz, ζ 0.37 mode. The polish met a Jacobian with a NaN, and nalgebra's `svd` never
+/// returns on one (a CPU profile of the stuck run: all of it in `SVD::new`); the
+/// decompositions are bounded since c6c37ec. It ends now, in a shaper that holds or an error.
+#[wasm_bindgen_test(unsupported = test)]
+fn a_vtol_profile_down_to_the_smallest_normal_number_ends() {
+    let spec = SiSpec {
+        vtol: -0.0,
+        band_hz: Some([0.7623072833017429, 1.642451375970284]),
+        vtol_profile: Some(vec![
+            [8.125437352970569e-285, 0.03810334979549615],
+            [1.5186110467120582, 2.2250738585072014e-308],
+            [1.8888378672601878, 0.07280723242393498],
+        ]),
+        amplitude_min: 0.0,
+        amplitude_max: 1.0,
+        max_impulses: Some(6),
+        ..Default::default()
+    };
+    let result = design(&spec.request(mode(30.084678125565432, 0.36871695620597994)));
+    // Vtol ≈ 0 over an interval around 1.52 Hz: no shaper of 6 positive impulses holds it.
+    assert!(matches!(result, Err(Error::Infeasible { .. })), "{result:?}");
+}
