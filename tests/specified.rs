@@ -661,5 +661,8 @@ fn a_vtol_profile_down_to_the_smallest_normal_number_ends() {
     };
     let result = design(&spec.request(mode(30.084678125565432, 0.36871695620597994)));
     // Vtol ≈ 0 over an interval around 1.52 Hz: no shaper of 6 positive impulses holds it.
-    assert!(matches!(result, Err(Error::Infeasible { .. })), "{result:?}");
+    assert!(
+        matches!(result, Err(Error::Infeasible { .. })),
+        "{result:?}"
+    );
 }
