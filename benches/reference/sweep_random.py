@@ -10,9 +10,13 @@ previous, damping ratios log-uniform in 0.015-0.15, peaks 0 to -6 dB under the f
 half-power band under the end by 5 %.  Writes resonances and calibration_data files and a
 manifest in the test set's format.  With --hard: modes 1.2-2.0 apart and down to -10 dB,
 noise 150-600 mm/s^2, and a third of the machines recorded raw (and as resonances) on a
-short sweep at 2 Hz/s from 0.75 times the lowest mode to 1.3 times the highest:
+short sweep at 2 Hz/s from 0.75 times the lowest mode to 1.3 times the highest.  With
+--rates: each sensor's sample rate drawn in 3000-3300 Hz (real ADXL345s run off their nominal
+3200 Hz: a Voron's files show f_s = 3070 Hz, whose 1.4991 Hz bins Klipper writes 1.5 apart with
+an occasional 1.4), from an RNG of its own, so the machines are those of the same seed without
+it:
 
-    python3 benches/reference/sweep_random.py OUT [N] [SEED] [--hard]
+    python3 benches/reference/sweep_random.py OUT [N] [SEED] [--hard] [--rates]
     SWEEP_RANDOM_DIR=OUT cargo test --release --test measure_testset -- --ignored random --nocapture
 
 numpy + scipy.
@@ -57,12 +61,15 @@ def draw(rng, i, hard=False):
                     i, excitation["freq_start"], excitation["freq_end"]))
 
 
-def main(out, n=16, seed=1, hard=False):
+def main(out, n=16, seed=1, hard=False, rates=False):
     os.makedirs(out, exist_ok=True)
     rng = random.Random(seed)
+    rate_rng = random.Random(seed * 1000003 + 17)
     manifest = {}
     for i in range(n):
         case = draw(rng, i, hard)
+        if rates:
+            case["rate"] = round(rate_rng.uniform(3000.0, 3300.0), 1)
         files = st.write_files(case, out)
         entry = {k: v for k, v in case.items() if not k.startswith("_") and k != "outputs"}
         entry["files"] = {k: v for k, v in files.items()
@@ -74,11 +81,12 @@ def main(out, n=16, seed=1, hard=False):
                         for m in case["modes"]), flush=True)
     with open(os.path.join(out, "manifest.json"), "w") as fh:
         json.dump({"generator": "benches/reference/sweep_random.py", "seed": seed, "hard": hard,
-                   "cases": manifest}, fh, indent=1, sort_keys=True)
+                   "rates": rates, "cases": manifest}, fh, indent=1, sort_keys=True)
 
 
 if __name__ == "__main__":
     hard = "--hard" in sys.argv
-    a = [x for x in sys.argv[1:] if x != "--hard"]
+    rates = "--rates" in sys.argv
+    a = [x for x in sys.argv[1:] if x not in ("--hard", "--rates")]
     main(a[0] if a else "/tmp/sweep_random", int(a[1]) if len(a) > 1 else 16,
-         int(a[2]) if len(a) > 2 else 1, hard)
+         int(a[2]) if len(a) > 2 else 1, hard, rates)
