@@ -433,7 +433,9 @@ fn bounded_svd(
     if m.iter().any(|v| !v.is_finite()) {
         return None;
     }
-    let budget = 1000 + 100 * m.nrows().max(m.ncols());
+    // Each of nalgebra's iterations is one implicit QR sweep of the bidiagonal (min(m, n)
+    // wide), which takes two or three per singular value (LAPACK's dbdsqr allows 6n²).
+    let budget = 1000 + 100 * m.nrows().min(m.ncols());
     m.try_svd(true, true, 5.0 * f64::EPSILON, budget)
 }
 
