@@ -425,7 +425,7 @@ fn log_slope(
 /// The singular value decomposition of `m` (U and Vᵀ computed), or `None` when it has a NaN or
 /// an infinity or does not converge within a budget of iterations: nalgebra's `svd` iterates
 /// until it converges, and on a matrix with a NaN it never does — a design request of the
-/// 10⁶-case property run spun there for hours (docs/testing.md). Same tolerance as `svd`
+/// 10⁶-case property run spun there for over an hour (docs/testing.md). Same tolerance as `svd`
 /// (5 ε), so the same decomposition wherever that one ends.
 fn bounded_svd(
     m: DMatrix<f64>,
