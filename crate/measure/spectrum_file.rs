@@ -163,9 +163,10 @@ pub fn resolution_of(f: &[f64]) -> (f64, bool) {
 /// every row: the narrowest band of parallel lines holding them all (the Chebyshev fit) is at
 /// most twice 0.051 Hz (`%.1f`'s half digit) and 0.1 % of a bin wide. The least-squares line's
 /// worst residual is no such test: Klipper writes the bins k·f_s/n with `%.1f`, and where
-/// f_s/n is a hair under 1.5 Hz (1.4991) the rows step by 1.5 up to 81.0 and by 1.5 again from
-/// 82.4 after one step of 1.4, within 0.05 Hz of that grid, but up to 0.061 Hz from the least-squares
-/// line through them (real `TEST_RESONANCES` files of a Voron 2.4 were refused so).
+/// f_s/n is a hair under 1.5 Hz (1.4991) the rows step by 1.5 up to 81.0 and by 1.5 again
+/// from 82.4 after one step of 1.4, within 0.05 Hz of that grid, but up to 0.061 Hz from the
+/// least-squares line through them (real `TEST_RESONANCES` files of a Voron 2.4 were refused
+/// so).
 pub(crate) fn resolution(f: &[f64]) -> (f64, bool) {
     let n = f.len();
     if n < 2 {
