@@ -439,6 +439,19 @@ fn bounded_svd(
     m.try_svd(true, true, 5.0 * f64::EPSILON, budget)
 }
 
+/// The eigen-decomposition of the symmetric `m`, bounded as [`bounded_svd`] is (nalgebra's
+/// `symmetric_eigen` iterates without limit too): `None` for a NaN or an infinity or past the
+/// budget, else nalgebra's own (same tolerance, ε).
+fn bounded_symmetric_eigen(
+    m: DMatrix<f64>,
+) -> Option<nalgebra::linalg::SymmetricEigen<f64, nalgebra::Dyn>> {
+    if m.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let budget = 1000 + 100 * m.nrows();
+    m.try_symmetric_eigen(f64::EPSILON, budget)
+}
+
 /// Result of the inner solve: y and the multipliers of c.
 struct Solved {
     y: Vec<f64>,
@@ -645,12 +658,8 @@ fn null_space_step(
         reduced_hessian(y, &lin.null, &lag)
     };
     // Positive definite (a minimum, not a saddle): eigenvalues by magnitude, floored. No step
-    // when the Hessian is not finite (its eigen-decomposition would never end: `bounded_svd`).
-    if hz.iter().any(|v| !v.is_finite()) {
-        return DVector::zeros(setup.n);
-    }
-    let budget = 1000 + 100 * hz.nrows();
-    let Some(eig) = hz.try_symmetric_eigen(f64::EPSILON, budget) else {
+    // when the Hessian has no decomposition (not finite).
+    let Some(eig) = bounded_symmetric_eigen(hz) else {
         return DVector::zeros(setup.n);
     };
     let emax = eig
@@ -1334,7 +1343,8 @@ mod tests {
     use super::*;
 
     /// A matrix with a NaN or an infinity has no decomposition (nalgebra's own `svd` and
-    /// `symmetric_eigen` never return on it), and a finite one gets nalgebra's own, bit for bit.
+    /// `symmetric_eigen` never return on it), and a finite one gets nalgebra's own, bit for bit
+    /// (the SVD of a 5 × 7 matrix, the eigen-decomposition of its 5 × 5 Gram matrix).
     #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
     fn decompositions_end_on_any_matrix() {
         let m = DMatrix::from_fn(5, 7, |r, c| {
@@ -1350,6 +1360,14 @@ mod tests {
             b[(2, 3)] = bad;
             assert!(bounded_svd(b).is_none(), "{bad}");
         }
+        let sym = &m * m.transpose();
+        let ours = bounded_symmetric_eigen(sym.clone()).expect("a finite matrix");
+        let theirs = sym.clone().symmetric_eigen();
+        assert_eq!(ours.eigenvalues, theirs.eigenvalues);
+        assert_eq!(ours.eigenvectors, theirs.eigenvectors);
+        let mut bad = sym;
+        bad[(1, 1)] = f64::NAN;
+        assert!(bounded_symmetric_eigen(bad).is_none());
     }
 
     /// A smooth non-quadratic test function with a closed-form Hessian:
