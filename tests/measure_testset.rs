@@ -283,7 +283,10 @@ fn every_case_of_the_independent_test_set() {
     for (label, within, rows, spurious) in &summary {
         println!("{label:<28} {within} of {rows} within the targets, {spurious} spurious");
     }
-    // Issue 20's target is every mode; today 48 of 51 meet it (46 of 49 before the case
+    // Issue 20's target is every mode; today 54 of 57 meet it (the close pairs pair56x76 and
+    // pair43x53, whose peaks 4-5 dB over the dip between them were read as one broad mode at
+    // neither frequency until a broad mode was split on the humps under it; 48 of 51 before
+    // them; 46 of 49 before the case
     // short36x123, whose start a spectrum file showed split over two bins, was added; 42 of
     // 45 before the case cliff133, 86a9f82; see docs/measured-data.md: the
     // slow machine's 1, 3.4 and 11 Hz modes from its resonances file — 13 bins of 1.95 Hz,
@@ -295,8 +298,8 @@ fn every_case_of_the_independent_test_set() {
     // be added that is not there, and the true ones must come out as well.
     for (label, within, rows, spurious) in &summary {
         assert!(
-            *within >= 48,
-            "{label}: {} of {rows} modes outside the targets (48 met when this bound was set)",
+            *within >= 54,
+            "{label}: {} of {rows} modes outside the targets (54 met when this bound was set)",
             rows - within
         );
         assert_eq!(*spurious, 0, "{label}: {spurious} spurious modes");

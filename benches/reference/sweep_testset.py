@@ -356,6 +356,14 @@ def cases():
         ("three", "y", 207, [mode(32.0, 0.06, 12.0), mode(51.0, 0.03, 14.0),
                              mode(87.0, 0.1, 10.0)],
          ["resonances", "calibration_data"], "three modes"),
+        # close pairs of damped modes, their peaks in the file within 0.5 dB of each other with
+        # a dip of 4-5 dB between them (as on several real printers' X axes): read as one
+        # broad mode until the identification split such a mode on the humps under it
+        ("pair56x76", "x", 210, [mode(56.0, 0.12, 12.0), mode(76.0, 0.10, 8.0)],
+         ["resonances", "calibration_data"],
+         "two modes, ratio 1.36, peaks 0.4 dB apart with a 4 dB dip between them"),
+        ("pair43x53", "y", 211, [mode(43.0, 0.06, 12.0), mode(53.0, 0.08, 10.5)],
+         ["resonances"], "two modes, ratio 1.23, the second 1.5 dB weaker"),
         # one machine: its X and Y axes (SHAPER_CALIBRATE without AXIS writes both, NAME m1),
         # and a second run of X with other noise (and drift) for robustness tests
         ("m1", "x", 301, [mode(42.0, 0.06, 14.0), mode(71.0, 0.04, 9.0)],
