@@ -812,8 +812,9 @@ fn best_fit(
 }
 
 /// Two humps of the data within f(1 ± 2ζ) of a fitted mode at f, ζ: local maxima of the
-/// log PSD (Klipper's normalisation undone, smoothed over ±max(1, 0.15 ζf/Δf) bins so a long
-/// record's noisy periodogram shows the mode's shape, not its bins), interior to the fitted
+/// log PSD (Klipper's normalisation undone, smoothed over ±⌊0.15 ζf/Δf⌋ bins so a long
+/// record's noisy periodogram shows the mode's shape, not its bins; a spectrum file's few,
+/// already averaged bins as they are), interior to the fitted
 /// bins and not within f_j(1 ± 2ζ_j) of another fitted mode (`others`: its own peak), the
 /// highest and the one with the deepest dip (≥ 1 dB under the lower of the two)
 /// between it and the highest. Their seeds: peak frequency, ζ from a quarter of their
@@ -831,7 +832,7 @@ fn humps(problem: &Problem, f0: f64, z0: f64, others: &[(f64, f64)]) -> Option<(
         .map(|(l, &fk)| l - problem.norm(fk).ln())
         .collect();
     let n = logs.len();
-    let h = ((0.15 * z0 * f0 / df) as usize).max(1);
+    let h = (0.15 * z0 * f0 / df) as usize;
     let sm: Vec<f64> = (0..n)
         .map(|j| {
             let (a, b) = (j.saturating_sub(h), (j + h).min(n - 1));
@@ -1038,14 +1039,20 @@ impl<'a> Setup<'a> {
                 ..keep
             };
             trial.push(other);
-            // Each mode stays on its hump (within a quarter of their separation): the split
-            // explains the two humps, not something else the fit wandered to.
+            // One mode stays on each hump (within a quarter of their separation; the fit may
+            // swap them): the split explains the two humps, not something else the fit
+            // wandered to.
             let reach = 0.25 * (a.frequency_hz - b.frequency_hz).abs();
-            self.accept(&trial, best, &[i, m]).filter(|(_, c)| {
-                [(i, keep), (m, other)]
-                    .iter()
-                    .all(|(j, h)| (c.0.x[3 * j].exp() - h.frequency_hz).abs() <= reach)
-            })
+            let on = |g: f64, h: &Seed| (g - h.frequency_hz).abs() <= reach;
+            let (mut trial, c) = self.accept(&trial, best, &[i, m])?;
+            let (gi, gm) = (c.0.x[3 * i].exp(), c.0.x[3 * m].exp());
+            if on(gi, &other) && on(gm, &keep) {
+                // Swapped: the detected peak's label goes with the mode on its hump.
+                trial[m].peak = trial[i].peak.take();
+            } else if !(on(gi, &keep) && on(gm, &other)) {
+                return None;
+            }
+            Some((trial, c))
         })
     }
 }
