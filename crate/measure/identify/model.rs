@@ -811,15 +811,14 @@ fn best_fit(
     best
 }
 
-/// Two humps of the data within f(1 ± 2ζ) of a fitted mode at f, ζ: local maxima of the
-/// log PSD (Klipper's normalisation undone, smoothed over ±⌊0.15 ζf/Δf⌋ bins so a long
-/// record's noisy periodogram shows the mode's shape, not its bins; a spectrum file's few,
-/// already averaged bins as they are), interior to the fitted
-/// bins and not within f_j(1 ± 2ζ_j) of another fitted mode (`others`: its own peak), the
-/// highest and the one with the deepest dip (≥ 1 dB under the lower of the two)
-/// between it and the highest. Their seeds: peak frequency, ζ from a quarter of their
-/// separation (the pair's half-power half-widths cannot exceed half of it), found in the
-/// residuals (`peak: None`).
+/// Two humps of the data within f(1 ± 2ζ) of a fitted mode at f, ζ: local maxima of the log
+/// PSD (Klipper's normalisation undone; smoothed over ±⌊0.15 ζf/Δf⌋ bins, so that a long
+/// record's noisy periodogram shows the mode's shape rather than its bins, while a spectrum
+/// file's few, already averaged bins are taken as they are), interior to the fitted bins and
+/// not within f_j(1 ± 2ζ_j) of another fitted mode (`others`: its own peak) — the highest,
+/// and the one with the deepest dip (≥ 1 dB under it) between it and the highest. Their
+/// seeds: the humps' frequencies, ζ from a quarter of their separation (a pair's half-power
+/// half-widths cannot exceed half of it), found in the residuals (`peak: None`).
 fn humps(problem: &Problem, f0: f64, z0: f64, others: &[(f64, f64)]) -> Option<(Seed, Seed)> {
     let input = problem.input;
     let f = input.frequency_hz;
@@ -1009,8 +1008,8 @@ impl<'a> Setup<'a> {
     }
 
     /// A fitted mode replaced by two, seeded on the two humps the data show within its
-    /// half-power band twice over ([`humps`]), when [`Setup::accept`] keeps them and each
-    /// fitted mode stays within a quarter of the humps' separation of its own: the broadest
+    /// half-power band twice over ([`humps`]), when [`Setup::accept`] keeps them and one
+    /// fitted mode stays on each hump (within a quarter of their separation): the broadest
     /// such mode first. Two modes whose peaks are a few dB apart with a shallow dip between
     /// them (ratio 1.2–1.45, ζ 0.04–0.12: 3–6 dB) fit as one broad mode better than as
     /// nothing, and a mode from the residuals is sought only outside a fitted mode's band, so
