@@ -365,8 +365,8 @@ def cases():
         ("pair43x53", "y", 211, [mode(43.0, 0.06, 12.0), mode(53.0, 0.08, 10.5)],
          ["resonances"], "two modes, ratio 1.23, the second 1.5 dB weaker"),
         # a broad mode with a sharp one about twice as high, the sharp one's peak 4 dB under
-        # the broad one's: the joint fit's starts missed its least-squares minimum (62.4 Hz
-        # read 64.9, then a spurious narrow mode bent the shape) until a start with the
+        # the broad one's: the joint fit's starts missed its least-squares minimum (62.4 / 0.19
+        # read 64.9 / 0.23 and 117.4 / 0.027 read 116.1 / 0.034) until a start with the
         # base-excited structure's signs was added
         ("broad62sharp117", "y", 212, [mode(62.4, 0.19, 12.0), mode(117.4, 0.027, 8.0)],
          ["resonances"], "a broad mode and a sharp one 1.88 times higher, 4 dB weaker"),
