@@ -35,6 +35,7 @@
 //! bins counted as n/ENBW independent ones, falls by more than 10. Uncertainties:
 //! s²(JᵀJ)⁻¹, inflated by √ENBW (neighbouring bins are correlated through the window).
 
+use super::peaks::smoothed_db;
 use super::{Estimate, Method, SignalKind};
 use crate::measure::fft::Complex;
 use crate::measure::fit::{minimise_below, FitResult, LeastSquares};
@@ -776,6 +777,17 @@ fn best_fit(
     let patterns = if m <= 4 { 1usize << (m - 1) } else { 1 };
     let mut fits = Vec::new();
     let mut least = f64::INFINITY;
+    // With every gain positive, the direct term their sum: a base-excited structure's
+    // transmissibility 1 − Σγᵢs²/Dᵢ (Σγᵢ = 1), which falls off above its modes — what a
+    // resonance test's sweep measures on a toolhead; from the other starts alone a broad mode
+    // with a sharp one twice as high fell into a minimum 4 % off (docs/measured-data.md,
+    // *Close pairs*). Not for a stationary record, whose excitation may be a force as well: on
+    // noisy white-noise records of one broad mode this start found lower sums further from
+    // the mode (RMS frequency error 0.68 → 0.89 %, tests/measure.rs).
+    let physical = (!problem.input.stationary).then(|| {
+        let x = start(seeds, 0, floor, 0.0, 0.0);
+        (0..m).map(|i| x[3 * i + 2]).sum::<f64>()
+    });
     for signs in 0..patterns {
         // The low-pass form (p = 0) of a flat logarithmic sweep sees a ≈ −1 (|A|² ∝ 1/f):
         // from 0 and 2 alone its fit fell into a minimum with two broad modes at 74–76 Hz.
@@ -786,18 +798,7 @@ fn best_fit(
         };
         for &a in exponents {
             let c0 = direct / (f[problem.bins[0]] / problem.f_ref).powf(0.5 * a);
-            // And, with every gain positive, the direct term their sum: a base-excited
-            // structure's transmissibility 1 − Σγᵢs²/Dᵢ (Σγᵢ = 1), which falls off above its
-            // modes — what a resonance test's sweep measures on a toolhead; from the others
-            // alone a broad mode with a sharp one twice as high fell into a minimum 4 % off
-            // (docs/measured-data.md, *Close pairs*). Not for a stationary record, whose
-            // excitation may be a force as well: on noisy white-noise records of one broad
-            // mode the extra start found lower sums further from the mode (RMS frequency error
-            // 0.68 → 0.89 %, tests/measure.rs).
-            let physical = (signs == 0 && !problem.input.stationary).then(|| {
-                let x = start(seeds, 0, floor, 0.0, a);
-                (0..m).map(|i| x[3 * i + 2]).sum::<f64>()
-            });
+            let physical = physical.filter(|_| signs == 0);
             for c in [c0, -c0, 0.0].into_iter().chain(physical) {
                 let x0 = start(seeds, signs, floor, c, a);
                 let q = problem.q_for(&x0, m);
@@ -843,13 +844,7 @@ fn humps(problem: &Problem, f0: f64, z0: f64, others: &[(f64, f64)]) -> Option<(
         .map(|(l, &fk)| l - problem.norm(fk).ln())
         .collect();
     let n = logs.len();
-    let h = (0.15 * z0 * f0 / df) as usize;
-    let sm: Vec<f64> = (0..n)
-        .map(|j| {
-            let (a, b) = (j.saturating_sub(h), (j + h).min(n - 1));
-            logs[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
-        })
-        .collect();
+    let sm = smoothed_db(&logs, 0, n - 1, (0.15 * z0 * f0 / df) as usize);
     let (lo, hi) = (f0 * (1.0 - 2.0 * z0), f0 * (1.0 + 2.0 * z0));
     // Not another fitted mode's own peak (within its half-power band twice over).
     let theirs = |g: f64| {
