@@ -66,7 +66,7 @@ mod sweep;
 use super::psd::{check_signal, Psd, WindowKind};
 use crate::error::{count, finite, positive, Result};
 use half_power::HalfPower;
-use model::{fit_modes, ModelInput, Seed, WindowSpec};
+use model::{fit_modes, FittedMode, ModelInput, Seed, WindowSpec};
 use serde::{Deserialize, Serialize};
 use spectrum_fit::spectrum_fit;
 use sweep::detect_sweep;
@@ -213,10 +213,16 @@ fn joint_fit(
             None => found.push(m),
         }
     }
-    // A mode found in the residuals (or split off a broad one) that lands on a detected peak
-    // whose own fitted mode went elsewhere is that peak's fit, not a second mode at its
-    // frequency (a fast log sweep reported 111.18 Hz from the peak's half-power seed beside
-    // the fit's 111.19 Hz); the others are modes of their own.
+    place_found(slots, found);
+    Some(past_fit)
+}
+
+/// Gives each mode found in the residuals (or split off a broad one) its slot. One that lands
+/// on a detected peak whose own fitted mode went elsewhere (the slot holds no spectrum-fit
+/// estimate) is that peak's fit, not a second mode at its frequency: a fast log sweep
+/// reported 111.18 Hz from the peak's half-power seed beside the fit's 111.19 Hz. The others
+/// are modes of their own.
+fn place_found(slots: &mut Vec<Slot>, found: Vec<FittedMode>) {
     for m in found {
         match slots.iter_mut().find(|s| {
             !s.estimates.iter().any(|e| e.method == Method::SpectrumFit) && s.fits(&m.estimate)
@@ -230,7 +236,6 @@ fn joint_fit(
             }),
         }
     }
-    Some(past_fit)
 }
 
 /// Whether a response rising into a sweep's end (its top at `top_hz`) is reported as cut off,
@@ -799,4 +804,80 @@ pub fn identify_spectrum(
         a.frequency_hz.total_cmp(&b.frequency_hz)
     });
     Ok(result)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn estimate(method: Method, frequency_hz: f64, damping: f64) -> Estimate {
+        Estimate {
+            method,
+            frequency_hz,
+            damping,
+            frequency_uncertainty_hz: 0.01 * frequency_hz,
+            damping_uncertainty: 0.1 * damping,
+        }
+    }
+
+    fn slot(estimates: Vec<Estimate>) -> Slot {
+        Slot {
+            peak_hz: estimates[0].frequency_hz,
+            peak_psd: 1.0,
+            prominence_db: 20.0,
+            estimates,
+        }
+    }
+
+    fn found(frequency_hz: f64, damping: f64) -> FittedMode {
+        FittedMode {
+            estimate: estimate(Method::SpectrumFit, frequency_hz, damping),
+            peak: None,
+            peak_psd: 0.5,
+            standing_db: 8.0,
+        }
+    }
+
+    /// The defect of 344aa08 (a fast log sweep of `sweep_chirps.py`, chirps seed 1's c08):
+    /// the detected 111.18 Hz peak kept only its half-power seed when its own fitted mode
+    /// went elsewhere, the fit's 111.19 Hz came back from the residuals, and both were
+    /// reported. Joining a slot without a fit of its own makes one mode of them.
+    #[test]
+    fn a_residual_mode_on_a_peak_without_its_own_fit_joins_that_peak() {
+        let mut slots = vec![
+            slot(vec![estimate(Method::HalfPower, 52.0, 0.05)]),
+            slot(vec![estimate(Method::HalfPower, 111.18, 0.04)]),
+        ];
+        // The first peak's fit stayed home; the second's did not.
+        slots[0].push_fit(estimate(Method::SpectrumFit, 52.1, 0.049));
+        place_found(&mut slots, vec![found(111.19, 0.035)]);
+        assert_eq!(slots.len(), 2);
+        let modes: Vec<IdentifiedMode> = slots.into_iter().map(Slot::into_mode).collect();
+        assert_eq!(modes[1].method, Method::SpectrumFit);
+        assert_eq!(modes[1].frequency_hz, 111.19);
+        assert_eq!(modes[1].damping, 0.035);
+        assert_eq!(modes[1].peak_frequency_hz, 111.18);
+        assert_eq!(modes[1].estimates.len(), 2);
+    }
+
+    /// A mode near a peak that has its own fit (one half of a split pair), or away from every
+    /// peak, is a mode of its own, reported with what the fit says of it.
+    #[test]
+    fn other_residual_modes_are_modes_of_their_own() {
+        let mut slots = vec![slot(vec![
+            estimate(Method::HalfPower, 56.0, 0.12),
+            estimate(Method::SpectrumFit, 55.9, 0.12),
+        ])];
+        place_found(&mut slots, vec![found(60.0, 0.1), found(140.0, 0.02)]);
+        assert_eq!(slots.len(), 3);
+        let modes: Vec<IdentifiedMode> = slots.into_iter().map(Slot::into_mode).collect();
+        assert_eq!(modes[0].frequency_hz, 55.9);
+        assert_eq!(modes[0].estimates.len(), 2);
+        for (m, f) in modes[1..].iter().zip([60.0, 140.0]) {
+            assert_eq!(m.frequency_hz, f);
+            assert_eq!(m.peak_frequency_hz, f);
+            assert_eq!(m.prominence_db, 8.0);
+            assert_eq!(m.estimates.len(), 1);
+        }
+    }
 }
