@@ -283,7 +283,11 @@ fn every_case_of_the_independent_test_set() {
     for (label, within, rows, spurious) in &summary {
         println!("{label:<28} {within} of {rows} within the targets, {spurious} spurious");
     }
-    // Issue 20's target is every mode; today 56 of 59 meet it (broad62sharp117, a broad mode
+    // Issue 20's target is every mode; today 59 of 62 meet it (swap63x100, a sharp mode under
+    // a broad one 1.58 times higher, whose fitted modes the joint fit returned swapped between
+    // their seeds: 62.99 Hz went to the broad peak's slot, 61.98 Hz was reported beside it and
+    // 99.8 Hz lost, until each fitted mode went to the peak it lies on; 56 of 59 before it;
+    // broad62sharp117, a broad mode
     // with a sharp one 1.88 times higher, read 64.9 / 0.23 and 116.1 / 0.034 until the joint
     // fit got a start with a base-excited structure's signs; the close pairs pair56x76 and
     // pair43x53, whose peaks 4-5 dB over the dip between them were read as one broad mode at
@@ -300,8 +304,8 @@ fn every_case_of_the_independent_test_set() {
     // be added that is not there, and the true ones must come out as well.
     for (label, within, rows, spurious) in &summary {
         assert!(
-            *within >= 56,
-            "{label}: {} of {rows} modes outside the targets (56 met when this bound was set)",
+            *within >= 59,
+            "{label}: {} of {rows} modes outside the targets (59 met when this bound was set)",
             rows - within
         );
         assert_eq!(*spurious, 0, "{label}: {spurious} spurious modes");

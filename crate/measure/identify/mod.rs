@@ -81,12 +81,17 @@ struct Slot {
 }
 
 impl Slot {
+    /// How far a spectrum-fit estimate lies from this slot's peak, in half-power half-widths
+    /// of its first estimate (ζ clamped to 0.01 … 0.3).
+    fn distance(&self, f: &Estimate) -> f64 {
+        let e0 = self.estimates[0];
+        (f.frequency_hz - e0.frequency_hz).abs() / (e0.frequency_hz * e0.damping.clamp(0.01, 0.3))
+    }
+
     /// Whether a spectrum-fit estimate lies on this slot's peak (within three half-power
     /// half-widths of its first estimate).
     fn fits(&self, f: &Estimate) -> bool {
-        let e0 = self.estimates[0];
-        (f.frequency_hz - e0.frequency_hz).abs()
-            < 3.0 * e0.frequency_hz * e0.damping.clamp(0.01, 0.3)
+        self.distance(f) < 3.0
     }
 
     /// Adds a spectrum-fit estimate unless it wandered off the peak.
@@ -184,7 +189,7 @@ fn joint_fit(
     } else {
         PastFit::NotNeeded
     };
-    let mut found = Vec::new();
+    let (mut seeded, mut found) = (Vec::new(), Vec::new());
     for m in fitted.modes {
         let (f, z) = (m.estimate.frequency_hz, m.estimate.damping);
         match m.peak {
@@ -209,12 +214,40 @@ fn joint_fit(
                 })
             }
             Some(i) if i == past => {}
-            Some(i) => slots[i].push_fit(m.estimate),
+            Some(_) => seeded.push(m.estimate),
             None => found.push(m),
         }
     }
+    place_seeded(&mut slots[..halves.len()], seeded);
     place_found(slots, found);
     Some(past_fit)
+}
+
+/// Gives each fitted mode seeded on a detected peak the slot of the peak it lies on: the
+/// nearest pairs first (in half-power half-widths of the peak's first estimate, within three,
+/// as [`Slot::fits`]), one mode to a slot. The fit may swap two seeds' modes: a resonances
+/// file's peaks at 62.0 (ζ 0.042) and 98.2 Hz (ζ 0.131, its half-power band 38 Hz wide)
+/// fitted as 99.79 / 0.1365 from the first seed and 62.99 / 0.0269 from the second, and by
+/// seed the second slot took 62.99 Hz while the first kept its half-power seed: 61.98 and
+/// 62.99 Hz were reported, 99.8 Hz lost. A mode on no free peak is dropped (it wandered off).
+fn place_seeded(slots: &mut [Slot], seeded: Vec<Estimate>) {
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for (k, e) in seeded.iter().enumerate() {
+        for (j, slot) in slots.iter().enumerate() {
+            if slot.fits(e) {
+                pairs.push((slot.distance(e), k, j));
+            }
+        }
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (mut mode_done, mut slot_done) = (vec![false; seeded.len()], vec![false; slots.len()]);
+    for (_, k, j) in pairs {
+        if !mode_done[k] && !slot_done[j] {
+            mode_done[k] = true;
+            slot_done[j] = true;
+            slots[j].push_fit(seeded[k]);
+        }
+    }
 }
 
 /// Gives each mode found in the residuals (or split off a broad one) its slot. One that lands
@@ -836,6 +869,54 @@ mod tests {
             peak_psd: 0.5,
             standing_db: 8.0,
         }
+    }
+
+    /// A generated resonances file (two modes 63.0 / 0.027 and 99.8 / 0.136 with a third at
+    /// 139 Hz): the joint fit returned the seeds' modes swapped. Each goes to the peak it
+    /// lies on; by seed index the broad peak's slot took 62.99 Hz and the sharp peak kept
+    /// only its half-power seed, and 99.8 Hz was lost.
+    #[test]
+    fn fitted_modes_swapped_by_the_fit_go_to_the_peaks_they_lie_on() {
+        let mut slots = vec![
+            slot(vec![estimate(Method::HalfPower, 61.98, 0.0418)]),
+            slot(vec![estimate(Method::HalfPower, 98.18, 0.1312)]),
+        ];
+        // In the seeds' order: the first seed's fit went to the broad mode.
+        let seeded = vec![
+            estimate(Method::SpectrumFit, 99.79, 0.1365),
+            estimate(Method::SpectrumFit, 62.99, 0.0269),
+        ];
+        place_seeded(&mut slots, seeded);
+        let modes: Vec<IdentifiedMode> = slots.into_iter().map(Slot::into_mode).collect();
+        assert_eq!(
+            modes
+                .iter()
+                .map(|m| (m.frequency_hz, m.damping, m.method))
+                .collect::<Vec<_>>(),
+            [
+                (62.99, 0.0269, Method::SpectrumFit),
+                (99.79, 0.1365, Method::SpectrumFit)
+            ]
+        );
+    }
+
+    /// One mode to a slot, nearest first; a mode on no peak (it wandered off) is dropped and
+    /// its peak keeps its half-power estimate.
+    #[test]
+    fn one_fitted_mode_to_a_peak_and_none_off_the_peaks() {
+        let mut slots = vec![
+            slot(vec![estimate(Method::HalfPower, 50.0, 0.05)]),
+            slot(vec![estimate(Method::HalfPower, 120.0, 0.03)]),
+        ];
+        let seeded = vec![
+            estimate(Method::SpectrumFit, 51.0, 0.05),
+            estimate(Method::SpectrumFit, 50.2, 0.05),
+            estimate(Method::SpectrumFit, 90.0, 0.05),
+        ];
+        place_seeded(&mut slots, seeded);
+        assert_eq!(slots[0].estimates.len(), 2);
+        assert_eq!(slots[0].estimates[1].frequency_hz, 50.2);
+        assert_eq!(slots[1].estimates.len(), 1);
     }
 
     /// The defect of 344aa08 (a fast log sweep of `sweep_chirps.py`, chirps seed 1's c08):
