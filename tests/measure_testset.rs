@@ -283,7 +283,10 @@ fn every_case_of_the_independent_test_set() {
     for (label, within, rows, spurious) in &summary {
         println!("{label:<28} {within} of {rows} within the targets, {spurious} spurious");
     }
-    // Issue 20's target is every mode; today 59 of 62 meet it (swap63x100, a sharp mode under
+    // Issue 20's target is every mode; today 62 of 65 meet it (three47r3022, a broad mode and
+    // two sharp ones, whose joint fit fell into a minimum of 500 times the least sum from every
+    // start until the physical start gave each mode its level under the excitation's slope;
+    // 59 of 62 before it; swap63x100, a sharp mode under
     // a broad one 1.58 times higher, whose fitted modes the joint fit returned swapped between
     // their seeds: 62.99 Hz went to the broad peak's slot, 61.98 Hz was reported beside it and
     // 99.8 Hz lost, until each fitted mode went to the peak it lies on; 56 of 59 before it;
@@ -304,8 +307,8 @@ fn every_case_of_the_independent_test_set() {
     // be added that is not there, and the true ones must come out as well.
     for (label, within, rows, spurious) in &summary {
         assert!(
-            *within >= 59,
-            "{label}: {} of {rows} modes outside the targets (59 met when this bound was set)",
+            *within >= 62,
+            "{label}: {} of {rows} modes outside the targets (62 met when this bound was set)",
             rows - within
         );
         assert_eq!(*spurious, 0, "{label}: {spurious} spurious modes");

@@ -404,6 +404,16 @@ def cases():
                   excitation=exc(35.8, 122.8, hps=2.0), outputs=["resonances"],
                   note="a short sweep 35.8-122.8 Hz at 2 Hz/s, noise 397 mm/s^2; its start "
                        "a cliff split over two bins"))
+    # A broad mode and two weaker sharp ones 1.8 and 2.8 times higher, on a sensor at 3022 Hz
+    # (sweep_random.py seed 14 --hard --rates, machine r32): every start of the joint fit fell
+    # into a minimum of 500 times the least sum (48.2, 85.4, 133.3 Hz) until the physical
+    # start gave each mode its level under the excitation's slope
+    c.append(dict(name="three47r3022", axis="x", rate=3022.0, seed=5032, noise=272.9,
+                  modes=[mode(47.02, 0.1409, 0.0), mode(85.74, 0.0644, -9.603588),
+                         mode(133.85, 0.0155, -9.379784)],
+                  excitation=FULL, outputs=["resonances"],
+                  note="a broad mode and two sharp ones up to 2.8 times higher, the sensor at "
+                       "3022 Hz, noise 273 mm/s^2; " + full))
     c.append(dict(name="noisy47", axis="y", rate=3200.0, seed=208, noise=400.0,
                   modes=[mode(47.3, 0.08, 14.0)], excitation=FULL, outputs=["resonances"],
                   note="single mode, noise 400 mm/s^2 (PSD floor ~100); " + full))

@@ -644,6 +644,26 @@ fn start(seeds: &[Seed], signs: usize, floor: f64, direct: f64, exponent: f64) -
     x
 }
 
+/// The base-excited structure's start ([`best_fit`]): every gain positive, each mode's peak
+/// E(fᵢ)·(gᵢ/2ζᵢ)² at its seed's level under the excitation E(f) = (f/f_ref)^a (gᵢ scaled by
+/// (f_ref/fᵢ)^(a/2) from [`start`]'s), the direct term their sum. Without the excitation's
+/// share the modes' levels were off by E(fᵢ) (a = 2: ×10 at 134 Hz for f_ref 43 Hz) and a
+/// three-mode resonances file (47.0 / 0.141, 85.7 / 0.064, 133.9 / 0.015) fell into a minimum
+/// of 500 times the sum (48.2, 85.4, 133.3 Hz; ζ 0.153, 0.082, 0.018) from every start; its
+/// calibration file, whose band starts 10 Hz rather than 9.2 (f_ref 44.5 Hz, not 42.6), had
+/// happened to reach the right one.
+fn physical_start(seeds: &[Seed], floor: f64, exponent: f64, f_ref: f64) -> Vec<f64> {
+    let mut x = start(seeds, 0, floor, 0.0, exponent);
+    let m = seeds.len();
+    let mut sum = 0.0;
+    for (i, s) in seeds.iter().enumerate() {
+        x[3 * i + 2] *= (f_ref / s.frequency_hz).powf(0.5 * exponent);
+        sum += x[3 * i + 2];
+    }
+    x[3 * m] = sum;
+    x
+}
+
 /// The fitted range: around every seed, −(60–80 %) … +max(8ζ, 80 %), inside the band; for a
 /// stationary excitation up to +max(8ζ, 200 %): the high flank far from a broad mode pins the
 /// floor, the direct term and the excitation's slope, which otherwise trade against its
@@ -799,10 +819,7 @@ fn best_fit(
     // *Close pairs*). Not for a stationary record, whose excitation may be a force as well: on
     // noisy white-noise records of one broad mode this start found lower sums further from
     // the mode (RMS frequency error 0.68 → 0.89 %, tests/measure.rs).
-    let physical = (!problem.input.stationary).then(|| {
-        let x = start(seeds, 0, floor, 0.0, 0.0);
-        (0..m).map(|i| x[3 * i + 2]).sum::<f64>()
-    });
+    let physical = !problem.input.stationary;
     for signs in 0..patterns {
         // The low-pass form (p = 0) of a flat logarithmic sweep sees a ≈ −1 (|A|² ∝ 1/f):
         // from 0 and 2 alone its fit fell into a minimum with two broad modes at 74–76 Hz.
@@ -813,9 +830,10 @@ fn best_fit(
         };
         for &a in exponents {
             let c0 = direct / (f[problem.bins[0]] / problem.f_ref).powf(0.5 * a);
-            let physical = physical.filter(|_| signs == 0);
-            for c in [c0, -c0, 0.0].into_iter().chain(physical) {
-                let x0 = start(seeds, signs, floor, c, a);
+            let plain = [c0, -c0, 0.0].map(|c| start(seeds, signs, floor, c, a));
+            let physical =
+                (physical && signs == 0).then(|| physical_start(seeds, floor, a, problem.f_ref));
+            for x0 in plain.into_iter().chain(physical) {
                 let q = problem.q_for(&x0, m);
                 if let Some(fit) = problem.fit_at(&x0, m, q, least) {
                     least = least.min(fit.rss);
@@ -1037,17 +1055,27 @@ impl<'a> Setup<'a> {
             };
             let (fk, zk) = (x[3 * k].exp(), x[3 * k + 1].exp());
             // In a sweep's whole-record periodogram (rectangular window, bins of 1/T), a mode
-            // must be resolved: a half-power width of a bin at least. A narrower one cannot be
+            // must be resolved: a half-power width of a bin at least, and two of the fitted
+            // bins (away from the seeds they are thinned) inside it. A narrower one cannot be
             // told from a line there (a drive's harmonic, the slow sweep's lines), and the fit
             // used such a term to bend its shape elsewhere (ζ 0.0018 at 19.5 Hz in a 4 s
-            // sweep). A spectrum file's sharp mode is read from the Kaiser kernel's tails: a
-            // 27 Hz, ζ 0.016 mode is half a bin wide there, and found.
+            // sweep; ζ 0.0004 at 30.7 Hz on one thinned bin of a 128 s sweep). A spectrum
+            // file's sharp mode is read from the Kaiser kernel's tails: a 27 Hz, ζ 0.016 mode
+            // is half a bin wide there, and found.
             let sweep = input
                 .window
                 .is_some_and(|w| w.kind == WindowKind::Rectangular);
-            problem.standing_db(x, trial.len(), k) >= need_db
-                && zk < 0.3
-                && (!sweep || 2.0 * zk * fk >= input.resolution_hz)
+            let resolved = || {
+                let f = input.frequency_hz;
+                2.0 * zk * fk >= input.resolution_hz
+                    && problem
+                        .bins
+                        .iter()
+                        .filter(|&&b| (f[b] - fk).abs() <= zk * fk)
+                        .count()
+                        >= 2
+            };
+            problem.standing_db(x, trial.len(), k) >= need_db && zk < 0.3 && (!sweep || resolved())
         });
         (stands && bic(&candidate.0, self.n_eff) < bic(&best.0, self.n_eff) - 10.0)
             .then(|| (trial.to_vec(), candidate))
