@@ -284,7 +284,7 @@ fn every_case_of_the_independent_test_set() {
         println!("{label:<28} {within} of {rows} within the targets, {spurious} spurious");
     }
     // Issue 20's target is every mode; today 62 of 65 meet it (three47r3022, a broad mode and
-    // two sharp ones, whose joint fit fell into a minimum of 500 times the least sum from every
+    // two sharp ones, whose joint fit fell into a minimum of 100 times the least sum from every
     // start until the physical start gave each mode its level under the excitation's slope;
     // 59 of 62 before it; swap63x100, a sharp mode under
     // a broad one 1.58 times higher, whose fitted modes the joint fit returned swapped between

@@ -406,7 +406,7 @@ def cases():
                        "a cliff split over two bins"))
     # A broad mode and two weaker sharp ones 1.8 and 2.8 times higher, on a sensor at 3022 Hz
     # (sweep_random.py seed 14 --hard --rates, machine r32): every start of the joint fit fell
-    # into a minimum of 500 times the least sum (48.2, 85.4, 133.3 Hz) until the physical
+    # into a minimum of 100 times the least sum (48.2, 85.4, 133.3 Hz) until the physical
     # start gave each mode its level under the excitation's slope
     c.append(dict(name="three47r3022", axis="x", rate=3022.0, seed=5032, noise=272.9,
                   modes=[mode(47.02, 0.1409, 0.0), mode(85.74, 0.0644, -9.603588),

@@ -649,7 +649,7 @@ fn start(seeds: &[Seed], signs: usize, floor: f64, direct: f64, exponent: f64) -
 /// (f_ref/fᵢ)^(a/2) from [`start`]'s), the direct term their sum. Without the excitation's
 /// share the modes' levels were off by E(fᵢ) (a = 2: ×10 at 134 Hz for f_ref 43 Hz) and a
 /// three-mode resonances file (47.0 / 0.141, 85.7 / 0.064, 133.9 / 0.015) fell into a minimum
-/// of 500 times the sum (48.2, 85.4, 133.3 Hz; ζ 0.153, 0.082, 0.018) from every start; its
+/// of 100 times the sum (48.2, 85.4, 133.3 Hz; ζ 0.153, 0.082, 0.018) from every start; its
 /// calibration file, whose band starts 10 Hz rather than 9.2 (f_ref 44.5 Hz, not 42.6), had
 /// happened to reach the right one.
 fn physical_start(seeds: &[Seed], floor: f64, exponent: f64, f_ref: f64) -> Vec<f64> {
@@ -845,9 +845,9 @@ fn best_fit(
     // A sweep's fits whose excitation slope no drive has are set aside while any start ended
     // with one that a drive has ([`SWEEP_EXPONENT`]).
     if !problem.input.stationary {
-        let physical = |fit: &FitResult| SWEEP_EXPONENT.contains(&fit.x[3 * m + 1]);
-        if fits.iter().any(|(fit, _)| physical(fit)) {
-            fits.retain(|(fit, _)| physical(fit));
+        let drivable = |fit: &FitResult| SWEEP_EXPONENT.contains(&fit.x[3 * m + 1]);
+        if fits.iter().any(|(fit, _)| drivable(fit)) {
+            fits.retain(|(fit, _)| drivable(fit));
             least = fits
                 .iter()
                 .map(|(fit, _)| fit.rss)
