@@ -1077,7 +1077,14 @@ impl<'a> Setup<'a> {
             };
             problem.standing_db(x, trial.len(), k) >= need_db && zk < 0.3 && (!sweep || resolved())
         });
-        (stands && bic(&candidate.0, self.n_eff) < bic(&best.0, self.n_eff) - 10.0)
+        // The modes the trial had before stay modes: each still stands over the model without
+        // it. Otherwise the new mode took an old one's place and the old one became a line or
+        // a notch (a 128 s sweep: the 39 Hz peak's seed went to 39.17 Hz, ζ 0.0001, standing
+        // −18.6 dB, while the mode from the residuals took 39.06 / 0.0189: both reported).
+        let kept = (0..trial.len())
+            .filter(|k| !new.contains(k))
+            .all(|k| problem.standing_db(x, trial.len(), k) > 0.0);
+        (stands && kept && bic(&candidate.0, self.n_eff) < bic(&best.0, self.n_eff) - 10.0)
             .then(|| (trial.to_vec(), candidate))
     }
 
