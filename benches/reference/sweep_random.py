@@ -14,9 +14,11 @@ short sweep at 2 Hz/s from 0.75 times the lowest mode to 1.3 times the highest. 
 --rates: each sensor's sample rate drawn in 3000-3300 Hz (real ADXL345s run off their nominal
 3200 Hz: a Voron's files show f_s = 3070 Hz, whose 1.4991 Hz bins Klipper writes 1.5 apart with
 an occasional 1.4), from an RNG of its own, so the machines are those of the same seed without
-it:
+it.  With --whole-raw (instead of --hard): each machine, hard or not at even odds, recorded raw
+over Klipper's whole test from 5 Hz at 1, 2 or 4 Hz/s and written as a resonances file too
+(draw_whole_raw):
 
-    python3 benches/reference/sweep_random.py OUT [N] [SEED] [--hard] [--rates]
+    python3 benches/reference/sweep_random.py OUT [N] [SEED] [--hard] [--rates] [--whole-raw]
     SWEEP_RANDOM_DIR=OUT cargo test --release --test measure_testset -- --ignored random --nocapture
 
 numpy + scipy.
@@ -61,13 +63,28 @@ def draw(rng, i, hard=False):
                     i, excitation["freq_start"], excitation["freq_end"]))
 
 
-def main(out, n=16, seed=1, hard=False, rates=False):
+def draw_whole_raw(rng, i):
+    """--whole-raw: a machine of `draw` (hard or not, even odds), recorded raw over Klipper's
+    whole test from 5 Hz (to the machine's own end, or 133.33 / 200 Hz for the short-sweep
+    machines) at 1, 2 or 4 Hz/s (1 twice as often), and written as a resonances file too."""
+    case = draw(rng, i, hard=rng.random() < 0.5)
+    ex = case["excitation"]
+    end = ex["freq_end"] if ex["freq_start"] == 5.0 else rng.choice([133.33, 200.0])
+    hps = rng.choice([1.0, 1.0, 2.0, 4.0])
+    case["excitation"] = st.exc(5.0, end, hps=hps)
+    case["outputs"] = ["raw", "resonances"]
+    case["name"] = "f%02d" % i
+    case["note"] = "random machine %d, raw, sweep 5-%g Hz at %g Hz/s" % (i, end, hps)
+    return case
+
+
+def main(out, n=16, seed=1, hard=False, rates=False, whole_raw=False):
     os.makedirs(out, exist_ok=True)
     rng = random.Random(seed)
     rate_rng = random.Random(seed * 1000003 + 17)
     manifest = {}
     for i in range(n):
-        case = draw(rng, i, hard)
+        case = draw_whole_raw(rng, i) if whole_raw else draw(rng, i, hard)
         if rates:
             case["rate"] = round(rate_rng.uniform(3000.0, 3300.0), 1)
         files = st.write_files(case, out)
@@ -87,6 +104,7 @@ def main(out, n=16, seed=1, hard=False, rates=False):
 if __name__ == "__main__":
     hard = "--hard" in sys.argv
     rates = "--rates" in sys.argv
-    a = [x for x in sys.argv[1:] if x not in ("--hard", "--rates")]
+    whole_raw = "--whole-raw" in sys.argv
+    a = [x for x in sys.argv[1:] if x not in ("--hard", "--rates", "--whole-raw")]
     main(a[0] if a else "/tmp/sweep_random", int(a[1]) if len(a) > 1 else 16,
-         int(a[2]) if len(a) > 2 else 1, hard, rates)
+         int(a[2]) if len(a) > 2 else 1, hard, rates, whole_raw)
