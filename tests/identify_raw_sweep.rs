@@ -517,7 +517,7 @@ fn raw_sweep_ends() {
 /// A short sweep (2 Hz/s, 22.9 → 67 Hz) through three base-excited modes whose peaks stand
 /// 7.5, 3.7 and 3.5 dB over their surroundings (`sweep_random.py` seed 13 `--hard`, r36, in
 /// this file's own simulation). With the excitation's exponent free, the one-mode fit of the
-/// only detected peak bent the excitation instead (E ∝ f^11.8 over the fitted band) and the
+/// only detected peak bent the excitation instead (E ∝ f^11.9 over the fitted band) and the
 /// two-mode fit stood the 30.5 Hz mode 2.3 dB over a model that already explained it by the
 /// slope: one mode, 53.6 Hz, came out of every draw. A sweep's fits whose slope a drive has
 /// (−6 … 6) are now preferred among the starts': all three modes, within the targets.
