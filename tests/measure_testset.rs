@@ -242,7 +242,7 @@ fn tally_in(dir: &str, manifest: &Value, max_modes: &dyn Fn(usize) -> usize) -> 
             .iter()
             .map(|m| (m["f"].as_f64().unwrap(), m["zeta"].as_f64().unwrap()))
             .collect();
-        let n = max_modes(truth.len()).min(MAX_MODES);
+        let n = max_modes(truth.len()).clamp(1, MAX_MODES);
         let axis = case["axis"].as_str().unwrap();
         for (kind, key) in [
             ("resonances", "resonances"),
@@ -283,6 +283,9 @@ fn every_case_of_the_independent_test_set() {
     for (label, within, rows, spurious) in &summary {
         println!("{label:<28} {within} of {rows} within the targets, {spurious} spurious");
     }
+    // rigid133 has no mode under its sweep's end: a line between its last two bins, raising no
+    // bin, was reported until a mode held back under the end had to raise the model at a bin
+    // (1 spurious without that rule, at every setting).
     // Issue 20's target is every mode; today 62 of 65 meet it (three47r3022, a broad mode and
     // two sharp ones, whose joint fit fell into a minimum of 100 times the least sum from every
     // start until the physical start gave each mode its level under the excitation's slope;

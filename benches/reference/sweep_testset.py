@@ -414,6 +414,13 @@ def cases():
                   excitation=FULL, outputs=["resonances"],
                   note="a broad mode and two sharp ones up to 2.8 times higher, the sensor at "
                        "3022 Hz, noise 273 mm/s^2; " + full))
+    # No mode in the band: a stiff machine swept 5-133.33 Hz, its PSD rising as f^2 into the
+    # sweep's end (sweep_random.py seed 15 --hard, machine r16): the resonances file read
+    # 130.45 Hz, zeta 0.00001 -- a line between the last two bins that no bin shows
+    c.append(dict(name="rigid133", axis="y", rate=3200.0, seed=5016, noise=440.9, modes=[],
+                  excitation=exc(5.0, 133.33), outputs=["resonances", "calibration_data"],
+                  note="no mode under 133.33 Hz (a stiff machine), noise 441 mm/s^2; "
+                       + full.replace("5-200", "5-133.33")))
     c.append(dict(name="noisy47", axis="y", rate=3200.0, seed=208, noise=400.0,
                   modes=[mode(47.3, 0.08, 14.0)], excitation=FULL, outputs=["resonances"],
                   note="single mode, noise 400 mm/s^2 (PSD floor ~100); " + full))

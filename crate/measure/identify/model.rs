@@ -101,6 +101,10 @@ pub(crate) struct FittedMode {
     pub peak_psd: f64,
     /// The mode's own peak over the model without it, dB.
     pub standing_db: f64,
+    /// The most the mode raises the model at the fitted bins (the window's kernel applied)
+    /// over the model without it, dB. A line between two bins stands high at its own
+    /// frequency and raises no bin: the data hold nothing of it.
+    pub binned_db: f64,
 }
 
 const SPAN_BINS: usize = 5;
@@ -551,6 +555,24 @@ impl Problem<'_> {
     /// The model's level at f (no kernel, no normalisation) with the floor.
     fn level(&self, x: &[f64], m: usize, f: f64) -> f64 {
         response(x, m, self.power, self.f_ref, f) + x[3 * m + 2].exp()
+    }
+
+    /// The most mode i raises the model at the fitted bins (at q fine steps per bin, the
+    /// window's kernel applied) over the model without it, dB.
+    fn binned_standing_db(&self, x: &[f64], m: usize, i: usize, q: usize) -> f64 {
+        let mut without = x.to_vec();
+        without[3 * i + 2] = 0.0;
+        let kern = self.kernel(q);
+        let (mut with, mut rest, mut fine) = (Vec::new(), Vec::new(), Vec::new());
+        if !self.eval(x, m, q, kern, &mut with, &mut fine)
+            || !self.eval(&without, m, q, kern, &mut rest, &mut fine)
+        {
+            return f64::NAN;
+        }
+        with.iter()
+            .zip(&rest)
+            .map(|(a, b)| 10.0 * (a / b.max(1e-300)).log10())
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// How far mode i stands over the model without it, at its frequency, dB.
@@ -1192,7 +1214,7 @@ pub(crate) fn fit_modes(input: &ModelInput, seeds: &[Seed], max_modes: usize) ->
         })
         .collect();
     Some(Fitted {
-        modes: modes_of(problem, &best.0, &seeds, setup.range),
+        modes: modes_of(problem, &best.0, best.1, &seeds, setup.range),
         top_db,
         bic: bic(&best.0, n_eff),
     })
@@ -1214,6 +1236,7 @@ pub(crate) struct Fitted {
 fn modes_of(
     problem: &Problem,
     fit: &FitResult,
+    q: usize,
     seeds: &[Seed],
     range: (f64, f64),
 ) -> Vec<FittedMode> {
@@ -1240,6 +1263,7 @@ fn modes_of(
             peak: seed.peak,
             peak_psd: problem.norm(fi) * problem.level(&fit.x, m, fi),
             standing_db: problem.standing_db(&fit.x, m, i),
+            binned_db: problem.binned_standing_db(&fit.x, m, i, q),
         });
     }
     out
