@@ -641,10 +641,32 @@ fn a_response_cut_off_by_the_sweeps_end_is_reported() {
     }
 }
 
+/// A stiff machine's files (`rigid133`: no mode under the sweep's end at 133.33 Hz, the PSD
+/// rising as the drive's f² into it) report no mode and say that the response still rises at
+/// the end. The resonances file reported a line between its last two bins, 130.45 Hz with
+/// ζ 0.00001, until a mode fitted back under the end had to raise the model at a fitted bin.
+#[test]
+fn a_file_without_modes_reports_none() {
+    for file in [
+        "resonances_y_rigid133.csv",
+        "calibration_data_y_rigid133.csv",
+    ] {
+        let Parsed::Spectrum(s) = read(file) else {
+            panic!("{file}: not a spectrum");
+        };
+        let id = identify_spectrum(&s, &IdentifyOptions::new(f64::NAN)).unwrap();
+        assert!(id.modes.is_empty(), "{file}: {:?}", id.modes);
+        let cut = id.cut_off.expect("the rise into the end is reported");
+        assert!((cut.frequency_hz - 131.2).abs() < 2.0, "{file}: {cut:?}");
+    }
+}
+
 /// No spectrum file of the test set says its response is cut off by the sweep's end: every
 /// true mode lies under its sweep's end by more than its half-power width (the guard of
 /// `a_response_cut_off_by_the_sweeps_end_is_reported`; short sweeps such as 38–56 Hz around
-/// a 47.3 Hz mode included).
+/// a 47.3 Hz mode included). Not `rigid133`, which has no mode under its end: its PSD rises
+/// as the drive's f² into the end, and that is what the note says (a mode past the end cannot
+/// be ruled out from such a file; its test is `a_file_without_modes_reports_none`).
 #[test]
 fn no_file_of_the_test_set_is_cut_off() {
     let manifest: Value = serde_json::from_str(
@@ -653,6 +675,9 @@ fn no_file_of_the_test_set_is_cut_off() {
     .unwrap();
     let mut files = 0;
     for case in manifest["cases"].as_object().unwrap().values() {
+        if case["modes"].as_array().unwrap().is_empty() {
+            continue;
+        }
         for key in ["resonances", "calibration_data"] {
             let Some(file) = case["files"][key].as_str() else {
                 continue;
