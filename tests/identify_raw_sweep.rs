@@ -123,6 +123,18 @@ fn all_found(id: &Identification, modes: &[SimMode], label: &str) {
     assert!(id.cut_off.is_none(), "{:?}", id.cut_off);
 }
 
+/// Klipper's sweep from `f0` to `f1` Hz at `rate` Hz/s through `modes`, recorded at 3.2 kHz
+/// with white noise of `noise` mm/s², one record per seed: each has its sweep found and
+/// exactly `modes` identified within the targets ([`all_found`]).
+fn all_found_on_draws(modes: &[SimMode], [f0, f1, rate]: [f64; 3], noise: f64, seeds: &[u64]) {
+    let fs = 3200.0;
+    for &seed in seeds {
+        let id = identified(&record(modes, f0, f1, rate, fs, noise, seed), fs);
+        assert!(id.sweep.is_some(), "seed {seed}: no sweep");
+        all_found(&id, modes, &format!("seed {seed}"));
+    }
+}
+
 /// The identification of a Klipper raw CSV's `accel_x` with the default options.
 fn identified_file(text: &str) -> Identification {
     let options = input_shaping::measure::RecordingOptions::default();
@@ -523,17 +535,12 @@ fn raw_sweep_ends() {
 /// (−6 … 6) are now preferred among the starts': all three modes, within the targets.
 #[test]
 fn a_sweeps_excitation_slope_does_not_stand_in_for_a_mode() {
-    let fs = 3200.0;
     let modes = [
         sim(30.49, 0.085, 0.0),
         sim(40.24, 0.149, -3.76),
         sim(51.51, 0.047, -4.01),
     ];
-    for seed in [100, 103, 106] {
-        let id = identified(&record(&modes, 22.9, 67.0, 2.0, fs, 171.2, seed), fs);
-        assert!(id.sweep.is_some(), "seed {seed}: no sweep");
-        all_found(&id, &modes, &format!("seed {seed}"));
-    }
+    all_found_on_draws(&modes, [22.9, 67.0, 2.0], 171.2, &[100, 103, 106]);
 }
 
 /// Klipper's whole test (5 → 200 Hz) at 4 Hz/s, recorded raw, through two broad modes a
@@ -546,13 +553,8 @@ fn a_sweeps_excitation_slope_does_not_stand_in_for_a_mode() {
 /// 63.32 / 0.116 from the first draw, 54.82 / 0.333 alone from the second.
 #[test]
 fn a_broad_pair_under_a_fast_whole_test_sweep_is_split() {
-    let fs = 3200.0;
     let modes = [sim(44.36, 0.1188, 0.0), sim(60.35, 0.1129, -0.82)];
-    for seed in [200, 201] {
-        let id = identified(&record(&modes, 5.0, 200.0, 4.0, fs, 150.0, seed), fs);
-        assert!(id.sweep.is_some(), "seed {seed}: no sweep");
-        all_found(&id, &modes, &format!("seed {seed}"));
-    }
+    all_found_on_draws(&modes, [5.0, 200.0, 4.0], 150.0, &[200, 201]);
 }
 
 /// The same sweep through a broad mode with a sharp, weaker one 1.34 times higher and a third
@@ -565,17 +567,12 @@ fn a_broad_pair_under_a_fast_whole_test_sweep_is_split() {
 /// 36.42 Hz (1.5 %), the least-squares minimum of those draws.
 #[test]
 fn a_split_beats_a_residual_mode_that_wandered() {
-    let fs = 3200.0;
     let modes = [
         sim(35.87, 0.1416, 0.0),
         sim(48.04, 0.0391, -5.86),
         sim(89.67, 0.073, -0.16),
     ];
-    for seed in [200, 202] {
-        let id = identified(&record(&modes, 5.0, 200.0, 4.0, fs, 150.0, seed), fs);
-        assert!(id.sweep.is_some(), "seed {seed}: no sweep");
-        all_found(&id, &modes, &format!("seed {seed}"));
-    }
+    all_found_on_draws(&modes, [5.0, 200.0, 4.0], 150.0, &[200, 202]);
 }
 
 /// A fast short sweep (1.4 s at 23 Hz/s, 32.4 → 65.4 Hz) through a mode 9 Hz above its start
@@ -585,11 +582,10 @@ fn a_split_beats_a_residual_mode_that_wandered() {
 /// was found. A peak whose low side the band's start cuts is now read on through the start.
 #[test]
 fn a_mode_near_a_fast_sweeps_start_is_found() {
-    let fs = 3200.0;
-    let modes = [sim(41.3, 0.08, 0.0)];
-    for seed in [300, 301, 302] {
-        let id = identified(&record(&modes, 32.4, 65.4, 23.0, fs, 189.0, seed), fs);
-        assert!(id.sweep.is_some(), "seed {seed}: no sweep");
-        all_found(&id, &modes, &format!("seed {seed}"));
-    }
+    all_found_on_draws(
+        &[sim(41.3, 0.08, 0.0)],
+        [32.4, 65.4, 23.0],
+        189.0,
+        &[300, 301, 302],
+    );
 }

@@ -297,26 +297,31 @@ pub(super) fn sweep_stage(
         h,
     );
     let reach = (2 * h2 + 1) as f64 * df;
+    // The peaks of the heavy smoothing in the band, their prominence read over `context`, away
+    // from those of `taken`.
+    let beyond = |context: [usize; 2], taken: &[Peak]| -> Vec<Peak> {
+        detect_within(
+            &psd,
+            [lo, hi],
+            context,
+            options.min_prominence_db,
+            MAX_MODES,
+            h2,
+        )
+        .into_iter()
+        .filter(|p| {
+            taken
+                .iter()
+                .all(|q| (q.frequency_hz - p.frequency_hz).abs() > reach)
+        })
+        .collect()
+    };
+    // A peak's index in the band's smoothings.
+    let at = |p: &Peak| ((p.frequency_hz / df).round() as usize).clamp(lo, hi) - lo;
     let context_hi = bins(&psd, band).1.max(hi);
-    let (edge, shoulders): (Vec<Peak>, Vec<Peak>) = detect_within(
-        &psd,
-        [lo, hi],
-        [lo, context_hi],
-        options.min_prominence_db,
-        MAX_MODES,
-        h2,
-    )
-    .into_iter()
-    .filter(|p| {
-        peaks
-            .iter()
-            .all(|q| (q.frequency_hz - p.frequency_hz).abs() > reach)
-    })
-    .partition(|p| {
-        let k = ((p.frequency_hz / df).round() as usize).clamp(lo, hi) - lo;
-        let low = heavy[k..].iter().cloned().fold(f64::INFINITY, f64::min);
-        low <= heavy[k] - 3.0
-    });
+    let (edge, shoulders): (Vec<Peak>, Vec<Peak>) = beyond([lo, context_hi], &peaks)
+        .into_iter()
+        .partition(|p| falls_3db(&heavy[at(p)..], heavy[at(p)]));
     // Likewise a peak whose low side the band's start cuts (the margin of √r above a fast
     // sweep's start takes its flank): its prominence read on through the sweep's start on the
     // heavy smoothing, kept when the periodogram smoothed as for the peaks falls ≥ 3 dB on
@@ -325,29 +330,14 @@ pub(super) fn sweep_stage(
     // under the peak (2.7 dB on the heavy smoothing), and no mode was found.
     let context_lo = bins(&psd, band).0.min(lo);
     let light = smoothed_db(&to_db(&psd.psd[lo..=hi]), 0, hi - lo, h);
-    let start_cut: Vec<Peak> = detect_within(
-        &psd,
-        [lo, hi],
-        [context_lo, hi],
-        options.min_prominence_db,
-        MAX_MODES,
-        h2,
-    )
-    .into_iter()
-    .filter(|p| {
-        peaks
-            .iter()
-            .chain(&edge)
-            .chain(&shoulders)
-            .all(|q| (q.frequency_hz - p.frequency_hz).abs() > reach)
-    })
-    .filter(|p| {
-        let k = ((p.frequency_hz / df).round() as usize).clamp(lo, hi) - lo;
-        let below = light[..=k].iter().cloned().fold(f64::INFINITY, f64::min);
-        let above = light[k..].iter().cloned().fold(f64::INFINITY, f64::min);
-        below <= light[k] - 3.0 && above <= light[k] - 3.0
-    })
-    .collect();
+    let taken: Vec<Peak> = [&peaks[..], &edge, &shoulders].concat();
+    let start_cut: Vec<Peak> = beyond([context_lo, hi], &taken)
+        .into_iter()
+        .filter(|p| {
+            let k = at(p);
+            falls_3db(&light[..=k], light[k]) && falls_3db(&light[k..], light[k])
+        })
+        .collect();
     peaks.extend(edge);
     peaks.extend(start_cut);
     crate::sort::sort_by(&mut peaks, |a, b| {
@@ -398,6 +388,12 @@ pub(super) fn sweep_stage(
         local,
         rising,
     }))
+}
+
+/// Whether any of `values` (dB) lies 3 dB or more under `top`: a peak's half-power point on
+/// that side.
+fn falls_3db(values: &[f64], top: f64) -> bool {
+    values.iter().any(|&v| v <= top - 3.0)
 }
 
 /// Whether a peak still stands out (by half `minProminenceDb`, on both sides within `context`)
