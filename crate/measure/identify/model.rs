@@ -895,9 +895,8 @@ fn best_fit(
 /// PSD (Klipper's normalisation undone; smoothed over ±⌊0.15 ζf/Δf⌋ bins of the whole grid, so
 /// that a long record's noisy periodogram shows the mode's shape rather than its bins, while a
 /// spectrum file's few, already averaged bins are taken as they are), interior to the fitted
-/// range and
-/// not within f_j(1 ± 2ζ_j) of another fitted mode (`others`: its own peak) — the highest,
-/// and the one with the deepest dip (≥ 1 dB under it) between it and the highest. Their
+/// range and not within f_j(1 ± 2ζ_j) of another fitted mode (`others`: its own peak) — the
+/// highest, and the one with the deepest dip (≥ 1 dB under it) between it and the highest. Their
 /// seeds: the humps' frequencies, ζ from a quarter of their separation (a pair's half-power
 /// half-widths cannot exceed half of it), found in the residuals (`peak: None`).
 fn humps(problem: &Problem, f0: f64, z0: f64, others: &[(f64, f64)]) -> Option<(Seed, Seed)> {
