@@ -304,7 +304,11 @@ test('dragging a mode keeps the other shapers live and ends with the solved shap
     }
     return changes;
   });
-  assert.ok(zvdChanges >= 30, `the ZVD followed the drag: ${zvdChanges} of 40 steps drawn`);
+  // A page whose main thread waited on the solved design would draw a step or two of 40. A
+  // live one draws 36-37 on this machine (two runs of this file), and drew 26 in one full
+  // `npm test` (2026-12-07, the machine otherwise quiet): at least half is asked, not 30,
+  // which failed that run.
+  assert.ok(zvdChanges >= 20, `the ZVD followed the drag: ${zvdChanges} of 40 steps drawn`);
   await settle(page);
   // The design worker's SI for the last frequency lands after the drag (on a loaded machine
   // after settle's two frames: "Shaper 1 is left out until the optimisation solver has
