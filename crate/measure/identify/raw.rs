@@ -277,79 +277,19 @@ pub(super) fn sweep_stage(
     }
     let root = root_at((fit_band[0] * fit_band[1]).sqrt());
     let h = ((0.125 * root / df).round() as usize).clamp(1, 200);
-    // Peaks standing out on both sides inside the band; then peaks whose high side the band's
-    // end cuts, their prominence read on through the sweep's end (past it the periodogram falls
-    // to the floor) on the periodogram smoothed 4 times as heavily: one side's 6 dB must not be
-    // one dip of the noise (a 2h + 1-bin mean of the periodogram scatters ~2 dB, and its
-    // lowest over thousands of bins lies 6–7 dB under its mean: a sweep over a band with no
-    // mode, the response at the noise floor, read a 74 Hz mode so). Those are kept when the
-    // smoothed periodogram falls ≥ 3 dB between them and the band's top (their high
-    // half-power point is fitted), as for a spectrum file's cliff (`spectrum::seeds`); the
-    // others are shoulders. A response still rising into the top is `rising`'s.
-    let h2 = (4 * h).min(800);
-    let heavy = smoothed_db(&to_db(&psd.psd[lo..=hi]), 0, hi - lo, h2);
-    let mut peaks = detect_within(
-        &psd,
-        [lo, hi],
-        [lo, hi],
-        options.min_prominence_db,
-        options.max_modes,
-        h,
-    );
-    let reach = (2 * h2 + 1) as f64 * df;
-    // The peaks of the heavy smoothing in the band, their prominence read over `context`, away
-    // from those of `taken`.
-    let beyond = |context: [usize; 2], taken: &[Peak]| -> Vec<Peak> {
-        detect_within(
-            &psd,
-            [lo, hi],
-            context,
-            options.min_prominence_db,
-            MAX_MODES,
-            h2,
-        )
-        .into_iter()
-        .filter(|p| {
-            taken
-                .iter()
-                .all(|q| (q.frequency_hz - p.frequency_hz).abs() > reach)
-        })
-        .collect()
-    };
-    // A peak's index in the band's smoothings.
-    let at = |p: &Peak| ((p.frequency_hz / df).round() as usize).clamp(lo, hi) - lo;
-    let context_hi = bins(&psd, band).1.max(hi);
-    let (edge, shoulders): (Vec<Peak>, Vec<Peak>) = beyond([lo, context_hi], &peaks)
-        .into_iter()
-        .partition(|p| falls_3db(&heavy[at(p)..], heavy[at(p)]));
-    // Likewise a peak whose low side the band's start cuts (the margin of √r above a fast
-    // sweep's start takes its flank): its prominence read on through the sweep's start on the
-    // heavy smoothing, kept when the periodogram smoothed as for the peaks falls ≥ 3 dB on
-    // each side of it inside the band (both half-power points fitted). A 1.5 s sweep at
-    // 23 Hz/s from 31.3 Hz through 41.3 Hz, ζ 0.08: the band fitted starts at 36.1 Hz, 5.3 dB
-    // under the peak (2.7 dB on the heavy smoothing), and no mode was found.
-    let context_lo = bins(&psd, band).0.min(lo);
-    let light = smoothed_db(&to_db(&psd.psd[lo..=hi]), 0, hi - lo, h);
-    let taken: Vec<Peak> = [&peaks[..], &edge, &shoulders].concat();
-    let start_cut: Vec<Peak> = beyond([context_lo, hi], &taken)
-        .into_iter()
-        .filter(|p| {
-            let k = at(p);
-            falls_3db(&light[..=k], light[k]) && falls_3db(&light[k..], light[k])
-        })
-        .collect();
-    peaks.extend(edge);
-    peaks.extend(start_cut);
-    crate::sort::sort_by(&mut peaks, |a, b| {
-        b.prominence_db.total_cmp(&a.prominence_db)
-    });
-    peaks.truncate(options.max_modes);
-    crate::sort::sort_by(&mut peaks, |a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    let band_bins = bins(&psd, band);
+    let context = [band_bins.0.min(lo), band_bins.1.max(hi)];
+    let h2 = heavy_bins(h);
+    let BandPeaks {
+        peaks,
+        shoulders,
+        heavy,
+    } = band_peaks(&psd, [lo, hi], context, h, options);
     let widths = half_powers(&psd, &peaks, fit_band, (2 * h + 1) as f64 * df, options);
     let over_noise = partial_noise_gate(&psd, sweep, band, h);
     let found: Vec<(Peak, HalfPower)> = unique(&peaks, &widths)
         .into_iter()
-        .filter(|(_, hp)| stands_at_its_width(&psd, hp, [lo, context_hi], h, options))
+        .filter(|(_, hp)| stands_at_its_width(&psd, hp, [lo, context[1]], h, options))
         .filter(|(_, hp)| over_noise(hp.peak_hz))
         .collect();
     // A sweep seen in part stands over the noise only inside its band: what lies below it
@@ -388,6 +328,104 @@ pub(super) fn sweep_stage(
         local,
         rising,
     }))
+}
+
+/// The heavy smoothing's half-width for the peaks' smoothing of ±h bins: 4h, at most 800.
+fn heavy_bins(h: usize) -> usize {
+    (4 * h).min(800)
+}
+
+/// What a sweep's band shows ([`sweep_stage`]), in bins `lo..=hi`: its peaks (at most
+/// `max_modes`, the most prominent, in frequency order), the shoulders under its top (peaks
+/// without their 3 dB fall there) and the periodogram smoothed over ±[`heavy_bins`] bins (dB,
+/// from `lo`).
+struct BandPeaks {
+    peaks: Vec<Peak>,
+    shoulders: Vec<Peak>,
+    heavy: Vec<f64>,
+}
+
+/// The peaks of a sweep's band `lo..=hi` on the periodogram smoothed over ±h bins, with those
+/// its ends cut, read on over `context` (the bins of the whole band asked for).
+fn band_peaks(
+    psd: &Psd,
+    [lo, hi]: [usize; 2],
+    context: [usize; 2],
+    h: usize,
+    options: &IdentifyOptions,
+) -> BandPeaks {
+    let df = psd.resolution_hz;
+    // Peaks standing out on both sides inside the band; then peaks whose high side the band's
+    // end cuts, their prominence read on through the sweep's end (past it the periodogram falls
+    // to the floor) on the periodogram smoothed 4 times as heavily: one side's 6 dB must not be
+    // one dip of the noise (a 2h + 1-bin mean of the periodogram scatters ~2 dB, and its
+    // lowest over thousands of bins lies 6–7 dB under its mean: a sweep over a band with no
+    // mode, the response at the noise floor, read a 74 Hz mode so). Those are kept when the
+    // smoothed periodogram falls ≥ 3 dB between them and the band's top (their high
+    // half-power point is fitted), as for a spectrum file's cliff (`spectrum::seeds`); the
+    // others are shoulders. A response still rising into the top is `rising`'s.
+    let h2 = heavy_bins(h);
+    let heavy = smoothed_db(&to_db(&psd.psd[lo..=hi]), 0, hi - lo, h2);
+    let mut peaks = detect_within(
+        psd,
+        [lo, hi],
+        [lo, hi],
+        options.min_prominence_db,
+        options.max_modes,
+        h,
+    );
+    let reach = (2 * h2 + 1) as f64 * df;
+    // The peaks of the heavy smoothing in the band, their prominence read over `context`, away
+    // from those of `taken`.
+    let beyond = |context: [usize; 2], taken: &[Peak]| -> Vec<Peak> {
+        detect_within(
+            psd,
+            [lo, hi],
+            context,
+            options.min_prominence_db,
+            MAX_MODES,
+            h2,
+        )
+        .into_iter()
+        .filter(|p| {
+            taken
+                .iter()
+                .all(|q| (q.frequency_hz - p.frequency_hz).abs() > reach)
+        })
+        .collect()
+    };
+    // A peak's index in the band's smoothings.
+    let at = |p: &Peak| ((p.frequency_hz / df).round() as usize).clamp(lo, hi) - lo;
+    let (edge, shoulders): (Vec<Peak>, Vec<Peak>) = beyond([lo, context[1]], &peaks)
+        .into_iter()
+        .partition(|p| falls_3db(&heavy[at(p)..], heavy[at(p)]));
+    // Likewise a peak whose low side the band's start cuts (the margin of √r above a fast
+    // sweep's start takes its flank): its prominence read on through the sweep's start on the
+    // heavy smoothing, kept when the periodogram smoothed as for the peaks falls ≥ 3 dB on
+    // each side of it inside the band (both half-power points fitted). A 1.5 s sweep at
+    // 23 Hz/s from 31.3 Hz through 41.3 Hz, ζ 0.08: the band fitted starts at 36.1 Hz, 5.3 dB
+    // under the peak (2.7 dB on the heavy smoothing), and no mode was found.
+    let light = smoothed_db(&to_db(&psd.psd[lo..=hi]), 0, hi - lo, h);
+    let taken: Vec<Peak> = [&peaks[..], &edge, &shoulders].concat();
+    let start_cut: Vec<Peak> = beyond([context[0], hi], &taken)
+        .into_iter()
+        .filter(|p| {
+            let k = at(p);
+            falls_3db(&light[..=k], light[k]) && falls_3db(&light[k..], light[k])
+        })
+        .collect();
+    peaks.extend(edge);
+    peaks.extend(start_cut);
+    crate::sort::sort_by(&mut peaks, |a, b| {
+        b.prominence_db.total_cmp(&a.prominence_db)
+    });
+    peaks.truncate(options.max_modes);
+    crate::sort::sort_by(&mut peaks, |a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    BandPeaks {
+        peaks,
+        shoulders,
+        heavy,
+    }
 }
 
 /// Whether any of `values` (dB) lies 3 dB or more under `top`: a peak's half-power point on
