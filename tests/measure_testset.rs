@@ -645,6 +645,8 @@ fn a_response_cut_off_by_the_sweeps_end_is_reported() {
 /// rising as the drive's f² into it) report no mode and say that the response still rises at
 /// the end. The resonances file reported a line between its last two bins, 130.45 Hz with
 /// ζ 0.00001, until a mode fitted back under the end had to raise the model at a fitted bin.
+/// The rise is reported at the last bin fitted before the cliff, 131.25 Hz (bins of 1.5625 Hz;
+/// the sweep ends at 133.33 Hz).
 #[test]
 fn a_file_without_modes_reports_none() {
     for file in [

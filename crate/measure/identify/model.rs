@@ -221,6 +221,14 @@ impl Unpacked {
     }
 }
 
+/// The parameters `x` with mode i's gain set to zero: the model without that mode (how far a
+/// mode stands over the rest is read against it).
+fn without_mode(x: &[f64], i: usize) -> Vec<f64> {
+    let mut without = x.to_vec();
+    without[3 * i + 2] = 0.0;
+    without
+}
+
 /// The model without kernel and normalisation at frequency f: E(f)|c + ΣgH|².
 fn response(x: &[f64], m: usize, power: i32, f_ref: f64, f: f64) -> f64 {
     Unpacked::new(x, m).response(power, f_ref, f)
@@ -560,8 +568,7 @@ impl Problem<'_> {
     /// The most mode i raises the model at the fitted bins (at q fine steps per bin, the
     /// window's kernel applied) over the model without it, dB.
     fn binned_standing_db(&self, x: &[f64], m: usize, i: usize, q: usize) -> f64 {
-        let mut without = x.to_vec();
-        without[3 * i + 2] = 0.0;
+        let without = without_mode(x, i);
         let kern = self.kernel(q);
         let (mut with, mut rest, mut fine) = (Vec::new(), Vec::new(), Vec::new());
         if !self.eval(x, m, q, kern, &mut with, &mut fine)
@@ -578,8 +585,7 @@ impl Problem<'_> {
     /// How far mode i stands over the model without it, at its frequency, dB.
     fn standing_db(&self, x: &[f64], m: usize, i: usize) -> f64 {
         let fi = x[3 * i].exp();
-        let mut without = x.to_vec();
-        without[3 * i + 2] = 0.0;
+        let without = without_mode(x, i);
         10.0 * (self.level(x, m, fi) / self.level(&without, m, fi).max(1e-300)).log10()
     }
 }
@@ -1227,8 +1233,7 @@ pub(crate) fn fit_modes(input: &ModelInput, seeds: &[Seed], max_modes: usize) ->
     let top = setup.range.1;
     let top_db = (0..seeds.len())
         .map(|i| {
-            let mut without = best.0.x.clone();
-            without[3 * i + 2] = 0.0;
+            let without = without_mode(&best.0.x, i);
             let m = seeds.len();
             10.0 * (problem.level(&best.0.x, m, top) / problem.level(&without, m, top).max(1e-300))
                 .log10()
