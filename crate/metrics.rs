@@ -426,7 +426,7 @@ fn stationary_points(a: f64, b: f64, c: f64) -> Vec<f64> {
     } else {
         vec![q / c, a / q]
     };
-    r.sort_by(f64::total_cmp);
+    crate::sort::sort_by(&mut r, f64::total_cmp);
     r
 }
 

@@ -142,8 +142,8 @@ pub(crate) fn undamped(humps: u32, vtol: f64) -> Undamped {
     let mut hump_list: Vec<f64> = (1..m)
         .map(|k| ratio(c * (k as f64 * PI / m as f64).cos()))
         .collect();
-    zeros.sort_by(f64::total_cmp);
-    hump_list.sort_by(f64::total_cmp);
+    crate::sort::sort_by(&mut zeros, f64::total_cmp);
+    crate::sort::sort_by(&mut hump_list, f64::total_cmp);
     // Multiply out Πⱼ (z² − 2cos θⱼ z + 1) over the zeros below the mode, times (z + 1) if m
     // is odd (the zero at θ = π).
     let mut poly = vec![1.0];

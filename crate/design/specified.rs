@@ -319,7 +319,7 @@ fn sampled_limits(
         Some((lo, _)) => vec![lo],
         None => modes.iter().map(|m| m.damping()).collect(),
     };
-    dampings.sort_by(f64::total_cmp);
+    crate::sort::sort_by(&mut dampings, f64::total_cmp);
     dampings.dedup();
     for &f in samples {
         for &z in &dampings {

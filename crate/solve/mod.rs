@@ -1040,7 +1040,7 @@ fn refine_pattern(grid: &GridSolution) -> Vec<f64> {
             }
         }
     }
-    pattern.sort_by(f64::total_cmp);
+    crate::sort::sort_by(&mut pattern, f64::total_cmp);
     pattern.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
     if let Some(last) = pattern.last_mut() {
         *last = 1.0;
