@@ -574,3 +574,50 @@ fn shapers_designed_elsewhere_are_used_as_given() {
     let (f, m) = field(r#"[{"impulses":[{"time":0,"amplitude":"one"}]}]"#);
     assert!(f.starts_with("designed[0]"), "{f}: {m}");
 }
+
+/// The shapers a frame hands out (`results[k].shaper` and the first one's `shaper`) have their
+/// impulse objects built in bulk by a small JS function (crate/js/bulk.rs) rather than by
+/// serde-wasm-bindgen: they must be what `design` (serde's path) gives for the same spec, to
+/// every number and key, for a short shaper, 4096 impulses and a factored convolution (ZV-D³
+/// over six modes: 15 625 impulses with its six `factors`).
+#[wasm_bindgen_test]
+fn render_playground_hands_out_the_shapers_design_gives() {
+    let modes = r#"[{"frequencyHz":1.2,"damping":0.02},{"frequencyHz":3.4,"damping":0.02},
+        {"frequencyHz":7.9,"damping":0.02},{"frequencyHz":13,"damping":0.02},
+        {"frequencyHz":21,"damping":0.02},{"frequencyHz":34,"damping":0.02}]"#;
+    let shapers = [
+        r#"{"family":"zv"}"#,
+        r#"{"family":"zvdd"}"#,
+        r#"{"family":"zvdn","derivatives":3}"#,
+    ];
+    let state = JSON::parse(&format!(
+        r#"{{"modes":{modes},"shapers":[{}],"view":{{"vtol":0.05}}}}"#,
+        shapers.join(",")
+    ))
+    .unwrap();
+    let out = wasm::render_playground(state, JsValue::NULL).unwrap();
+    let results = js_sys::Array::from(&Reflect::get(&out, &"results".into()).unwrap());
+    let text = |v: &JsValue| String::from(JSON::stringify(v).unwrap());
+    for (k, spec) in shapers.iter().enumerate() {
+        let spec = JSON::parse(&format!(r#"{{"modes":{modes},{}"#, &spec[1..])).unwrap();
+        let fresh = wasm::design(spec).unwrap();
+        let given = Reflect::get(&results.get(k as u32), &"shaper".into()).unwrap();
+        assert_eq!(text(&given), text(&fresh), "shaper {k}");
+        let factors = Reflect::get(&given, &"factors".into()).unwrap();
+        let count = js_sys::Array::from(&Reflect::get(&given, &"impulses".into()).unwrap());
+        match k {
+            2 => {
+                assert_eq!(count.length(), 15_625);
+                assert_eq!(js_sys::Array::from(&factors).length(), 6);
+            }
+            _ => assert!(factors.is_undefined(), "shaper {k}: no factors"),
+        }
+    }
+    let first = Reflect::get(&out, &"shaper".into()).unwrap();
+    let first_result = Reflect::get(&results.get(0), &"shaper".into()).unwrap();
+    assert_eq!(
+        text(&first),
+        text(&first_result),
+        "the first shaper's fields"
+    );
+}

@@ -8,6 +8,8 @@
 //! - [`realise`]: the page's realisation view's chart (`drawRealisation`);
 //! - `corner`: the page's printed-corner view, `renderCorner` (feature `js-corner`);
 //! - [`playground`]: the page's frame, `renderPlayground`, in its stages;
+//! - `bulk`: a shaper's impulses built as JS objects in bulk (the page's frame hands out
+//!   ~20 000 of them with six modes);
 //! - `args`: the exports' arguments checked as what they must be (a string, a number, a
 //!   canvas, an array of numbers), whatever JS passes;
 //! - `jsde`: the reader of JS values (serde, with the path of the failing field);
@@ -18,6 +20,8 @@
 
 pub mod api;
 pub(crate) mod args;
+#[cfg(feature = "js-playground")]
+pub(crate) mod bulk;
 pub(crate) mod canvas;
 #[cfg(feature = "js-corner")]
 pub mod corner;

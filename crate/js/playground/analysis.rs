@@ -19,6 +19,7 @@ use std::cell::RefCell;
 pub(super) struct ShaperResult {
     pub label: String,
     pub family: &'static str,
+    #[serde(serialize_with = "crate::js::bulk::serialize_shaper")]
     pub shaper: ShaperData,
     pub sensitivity: vibration::SensitivityCurve,
     pub insensitivity: Vec<vibration::Insensitivity>,

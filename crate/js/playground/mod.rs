@@ -50,6 +50,7 @@ struct PlaygroundResult {
     /// One entry per compared shaper, in order.
     results: Vec<ShaperResult>,
     // The first shaper's figures, as the single-shaper page had them.
+    #[serde(serialize_with = "crate::js::bulk::serialize_shaper")]
     shaper: ShaperData,
     sensitivity: vibration::SensitivityCurve,
     insensitivity: Vec<vibration::Insensitivity>,
