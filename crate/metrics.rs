@@ -8,7 +8,7 @@
 
 use crate::command::Command;
 use crate::error::{finite, Result};
-use crate::piecewise::{taylor_shift, Knot, Piecewise, ORDER};
+use crate::piecewise::{taylor_shift, Knot, Piecewise, Step, ORDER};
 use crate::plant::modal::ModalPlant;
 use crate::simulate::Trajectory;
 use serde::Serialize;
@@ -226,6 +226,9 @@ impl CommandFigures {
     /// reference has few knots (a six-mode ZV-D³ shapes a trapezoid into 62 500 knots). Errors
     /// as `shaped` does (too many knots, a non-finite product).
     pub fn of_shaped(reference: &Piecewise, shaper: &crate::shaper::Shaper) -> Result<Self> {
+        if let Some(steps) = reference.shaped_steps(shaper)? {
+            return step_figures(steps, reference.degree());
+        }
         let Some(mut knots) = reference.shaped_knots(shaper)? else {
             return CommandFigures::of(&Command::Piecewise(reference.shaped(shaper)?));
         };
@@ -240,6 +243,46 @@ impl CommandFigures {
         }
         Ok(figures)
     }
+}
+
+/// [`knot_figures`] of a command of degree at most `degree` ≤ 2 given as its [`Step`]s (sorted,
+/// merged), taken again at the degree the steps have when that is lower (as
+/// [`CommandFigures::of_shaped`] does): the same numbers to the bit, by the same arithmetic on
+/// what the walk reads of it. The acceleration is constant between knots, so its samples are
+/// its value after each knot (a Taylor shift of the acceleration alone is the identity:
+/// `0.0 + a`), the jerk's are 0, and each is unbounded where a lower derivative jumps.
+fn step_figures(steps: impl Iterator<Item = Step>, degree: usize) -> Result<CommandFigures> {
+    let mut acceleration = vec![0.0];
+    let (mut end, mut seen, mut first, mut a) = (0.0, 0, true, 0.0);
+    let (mut unbounded_acceleration, mut unbounded_jerk) = (false, false);
+    for (time, j) in steps {
+        if !time.is_finite() || j.iter().any(|x| !x.is_finite()) {
+            finite("command.time", time)?;
+            for x in j {
+                finite("command", x)?;
+            }
+        }
+        if let Some(top) = j.iter().rposition(|&x| x != 0.0) {
+            seen = seen.max(top);
+        }
+        unbounded_acceleration |= j[0] != 0.0 || j[1] != 0.0;
+        unbounded_jerk |= j.iter().any(|&x| x != 0.0);
+        a = if first { 0.0 } else { 0.0 + a } + j[2];
+        first = false;
+        end = time;
+        acceleration.push(if degree == 2 { a } else { 0.0 });
+    }
+    if seen < degree {
+        // Walked again at the lower degree: an acceleration of 0 throughout.
+        acceleration.iter_mut().for_each(|x| *x = 0.0);
+    }
+    let max_abs = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    Ok(CommandFigures {
+        move_end: end,
+        peak_acceleration: (!unbounded_acceleration).then(|| max_abs(&acceleration)),
+        peak_jerk: (!unbounded_jerk).then_some(0.0),
+        acceleration_peak_valley_count: peak_valley_count(&acceleration),
+    })
 }
 
 /// The figures of a piecewise command given as its knots (sorted, merged) and a bound on its
@@ -512,13 +555,16 @@ pub fn peak_valley_count(x: &[f64]) -> usize {
 
 #[cfg(test)]
 mod tests {
-    use super::{peak_valley_count, sample_derivative, CommandFigures, Sampling, PER_PIECE};
+    use super::{
+        knot_figures, peak_valley_count, sample_derivative, step_figures, CommandFigures, Sampling,
+        PER_PIECE,
+    };
     use crate::command::Command;
     use crate::command::{s_curve, trapezoid};
     use crate::design::zero_vibration::{zv, zvd};
     use crate::mode::Mode;
     use crate::piecewise::Cursor;
-    use crate::piecewise::Piecewise;
+    use crate::piecewise::{Knot, Piecewise, ORDER};
 
     /// `bases`, and each shaped by ZV and ZVD at every frequency of `freqs` (ζ 0.05):
     /// overlapping impulse responses make pieces of every slope.
@@ -727,6 +773,135 @@ mod tests {
         assert!(checked >= 18, "{checked} compared");
         let too_many = shapers[3].len() * references[3].knots().len();
         assert!(too_many > crate::piecewise::MAX_KNOTS, "one error compared");
+    }
+
+    /// The narrow path for commands of degree ≤ 2 (`Piecewise::shaped_steps`, `step_figures`)
+    /// against the general one (`shaped_knots` walked by `knot_figures`, again at the degree
+    /// seen when lower), to the bit: the same knots (time and the three jumps) and the same
+    /// figures, for a trapezoid, a triangle, a ramp and a step, each delayed and negated too,
+    /// shaped by ZV, ZVD, six-mode ZV-D³, a unity-magnitude negative shaper, two impulses that
+    /// cancel a knot, impulses that land on the trapezoid's own knots (merged across runs), and
+    /// a zero-sum pair; a product that overflows: the same error.
+    #[test]
+    fn figures_of_low_degree_commands_take_the_narrow_path_to_the_same_bits() {
+        use crate::command::{ramp, step};
+        use crate::design::{design, DesignRequest, ShaperSpec};
+        use crate::mode::ModeSpec;
+        use crate::shaper::{Impulse, Shaper};
+        let general = |r: &Piecewise, s: &Shaper| {
+            let d = r.degree();
+            let (f, seen) = knot_figures(&mut r.shaped_knots(s).unwrap().unwrap(), d).unwrap();
+            if seen < d {
+                knot_figures(&mut r.shaped_knots(s).unwrap().unwrap(), seen)
+                    .unwrap()
+                    .0
+            } else {
+                f
+            }
+        };
+        let bits = |t: f64, j: &[f64]| {
+            (
+                t.to_bits(),
+                j.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            )
+        };
+        let mut references = vec![
+            trapezoid(1.0, 0.75, 8.0, 0.0).unwrap(),
+            trapezoid(0.01, 0.75, 8.0, 0.0).unwrap(), // triangular
+            trapezoid(-2.0, 0.3, 3.0, 0.25).unwrap(),
+            ramp(0.5, 0.1).unwrap(),
+            step(1.0, 0.0).unwrap(),
+        ];
+        assert!(references[1].knots().len() == 3, "a triangle");
+        references.push(Piecewise::new(Vec::new()).unwrap());
+        let impulses = |v: &[(f64, f64)]| {
+            Shaper::new(
+                v.iter()
+                    .map(|&(time, amplitude)| Impulse { time, amplitude })
+                    .collect(),
+            )
+            .unwrap()
+        };
+        let modes = |f: &[f64]| {
+            f.iter()
+                .map(|&f| ModeSpec {
+                    frequency_hz: f,
+                    damping: 0.02,
+                })
+                .collect()
+        };
+        let designed = |spec: ShaperSpec, f: &[f64]| {
+            design(&DesignRequest {
+                modes: modes(f),
+                shaper: spec,
+            })
+            .unwrap()
+        };
+        let six = [1.2, 3.4, 7.9, 13.0, 21.0, 34.0];
+        let shapers = [
+            designed(ShaperSpec::Zv, &[2.0]),
+            designed(ShaperSpec::Zvd, &[1.2, 3.4]),
+            designed(ShaperSpec::Zvdn { derivatives: 3 }, &six),
+            designed(ShaperSpec::Umzv, &[3.0]),
+            // Half of each jump at 0 and 0.09375 s: the trapezoid's first two knots' sum cancels.
+            impulses(&[(0.0, 0.5), (0.09375, 0.5)]),
+            // At the trapezoid's knot spacing (its acceleration lasts 0.09375 s, its cruise
+            // 1.24 s): knots of different runs on the same time, merged.
+            impulses(&[
+                (0.0, 0.25),
+                (0.09375, 0.25),
+                (1.3333333333333333, 0.25),
+                (1.4270833333333333, 0.25),
+            ]),
+            // Amplitudes summing to zero (a force-profile move's kind).
+            impulses(&[(0.0, 1.0), (0.2, -1.0)]),
+        ];
+        let mut compared = 0;
+        for r in &references {
+            for s in &shapers {
+                let steps: Vec<_> = r.shaped_steps(s).unwrap().expect("degree ≤ 2").collect();
+                let knots: Vec<_> = r.shaped_knots(s).unwrap().unwrap().collect();
+                assert_eq!(
+                    steps.iter().map(|(t, j)| bits(*t, j)).collect::<Vec<_>>(),
+                    knots
+                        .iter()
+                        .map(|k| bits(k.time, &k.jumps[..3]))
+                        .collect::<Vec<_>>(),
+                );
+                assert!(knots.iter().all(|k| k.jumps[3..].iter().all(|&j| j == 0.0)));
+                let narrow = step_figures(r.shaped_steps(s).unwrap().unwrap(), r.degree()).unwrap();
+                assert_eq!(format!("{narrow:?}"), format!("{:?}", general(r, s)));
+                assert_eq!(
+                    format!("{:?}", CommandFigures::of_shaped(r, s).unwrap()),
+                    format!("{narrow:?}")
+                );
+                compared += 1;
+            }
+        }
+        assert_eq!(compared, 42);
+        let merged = trapezoid(1.0, 0.75, 8.0, 0.0)
+            .unwrap()
+            .shaped_steps(&shapers[5])
+            .unwrap()
+            .unwrap()
+            .count();
+        assert!(merged < 16, "knots of different runs merged: {merged}");
+        // Overflow: the same error either way.
+        let jump = |time: f64, value: f64| {
+            let mut jumps = [0.0; ORDER];
+            jumps[2] = value;
+            Knot { time, jumps }
+        };
+        let huge = Piecewise::new(vec![jump(0.0, 1e300), jump(1.0, -1e300)]).unwrap();
+        let big = impulses(&[(0.0, 1e12), (1.0, -1e12 + 1.0)]);
+        let got = CommandFigures::of_shaped(&huge, &big);
+        let walked = knot_figures(&mut huge.shaped_knots(&big).unwrap().unwrap(), 2);
+        assert!(got.is_err(), "{got:?}");
+        assert_eq!(got.unwrap_err(), walked.unwrap_err());
+        assert_eq!(
+            CommandFigures::of_shaped(&huge, &big).unwrap_err(),
+            huge.shaped(&big).unwrap_err()
+        );
     }
 
     /// The roots of a + bτ + cτ², against the closed form.

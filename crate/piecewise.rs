@@ -200,6 +200,34 @@ impl Piecewise {
         Ok(Some(MergedKnots::new(Box::new(runs), span)))
     }
 
+    /// [`Piecewise::shaped_knots`] for a command of degree ≤ 2 (jumps in position, velocity and
+    /// acceleration only: trapezoids, triangles), each knot as its time and those three jumps:
+    /// the same knots merged the same way, to the bit, in 32 bytes a knot instead of 80 — what
+    /// the shaped command's figures walk (`CommandFigures::of_shaped`: a six-mode ZV-D³ shapes
+    /// a trapezoid into 62 500 knots, and moving 80-byte knots through the merge was most of
+    /// that walk's time). `None` for a higher degree or more than 16 knots. Errors as `shaped`.
+    pub(crate) fn shaped_steps<'a>(
+        &'a self,
+        shaper: &'a Shaper,
+    ) -> Result<Option<ShapedSteps<'a>>> {
+        self.shaped_len(shaper)?;
+        if self.knots.len() > MERGED_RUNS || self.degree > 2 {
+            return Ok(None);
+        }
+        let runs = ShapedRuns::new(&self.knots, shaper.impulses());
+        let span = match (runs.first_time(), runs.last_time()) {
+            (Some(a), Some(b)) => merge_span(a, b),
+            _ => 0.0,
+        };
+        let mut steps = ShapedSteps {
+            runs,
+            tol: (KNOT_MERGE * span).max(1e-15),
+            pending: None,
+        };
+        steps.pending = steps.raw();
+        Ok(Some(steps))
+    }
+
     /// The derivative of the command (its jumps moved one order down; the position jumps
     /// become impulses, which are dropped — use only for commands with continuous position).
     pub fn derivative(&self) -> Result<Piecewise> {
@@ -309,6 +337,54 @@ impl Iterator for ShapedRuns<'_> {
 
     fn size_hint(&self) -> (usize, Option<usize>) {
         (self.left, Some(self.left))
+    }
+}
+
+/// A knot of a command of degree ≤ 2: its time and its jumps in position, velocity and
+/// acceleration.
+pub(crate) type Step = (f64, [f64; 3]);
+
+/// The knots of [`Piecewise::shaped_steps`]: [`ShapedRuns`] merged as [`MergedKnots`] merges
+/// them, on [`Step`]s — the same merging (into the first knot within the tolerance, jumps
+/// summed in order) and the same knots dropped (all jumps zero: above acceleration they are
+/// zero in a command of degree ≤ 2).
+pub(crate) struct ShapedSteps<'a> {
+    runs: ShapedRuns<'a>,
+    tol: f64,
+    pending: Option<Step>,
+}
+
+impl ShapedSteps<'_> {
+    /// The next knot before merging.
+    fn raw(&mut self) -> Option<Step> {
+        let k = self.runs.next()?;
+        Some((k.time, [k.jumps[0], k.jumps[1], k.jumps[2]]))
+    }
+}
+
+impl Iterator for ShapedSteps<'_> {
+    type Item = Step;
+
+    fn next(&mut self) -> Option<Step> {
+        loop {
+            let (time, mut jumps) = self.pending.take()?;
+            loop {
+                match self.raw() {
+                    Some((t, j)) if t - time <= self.tol => {
+                        for (a, b) in jumps.iter_mut().zip(j) {
+                            *a += b;
+                        }
+                    }
+                    next => {
+                        self.pending = next;
+                        break;
+                    }
+                }
+            }
+            if jumps.iter().any(|&j| j != 0.0) {
+                return Some((time, jumps));
+            }
+        }
     }
 }
 
