@@ -778,8 +778,8 @@ mod tests {
     /// The narrow path for commands of degree ≤ 2 (`Piecewise::shaped_steps`, `step_figures`)
     /// against the general one (`shaped_knots` walked by `knot_figures`, again at the degree
     /// seen when lower), to the bit: the same knots (time and the three jumps) and the same
-    /// figures, for a trapezoid, a triangle, a ramp and a step, each delayed and negated too,
-    /// shaped by ZV, ZVD, six-mode ZV-D³, a unity-magnitude negative shaper, two impulses that
+    /// figures, for a trapezoid, a triangle, a delayed negative trapezoid, a ramp, a step and a
+    /// command without knots, shaped by ZV, ZVD, six-mode ZV-D³, a unity-magnitude negative shaper, two impulses that
     /// cancel a knot, impulses that land on the trapezoid's own knots (merged across runs), and
     /// a zero-sum pair; a product that overflows: the same error.
     #[test]

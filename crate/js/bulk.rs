@@ -1,9 +1,9 @@
 //! A shaper's impulses handed to JavaScript in bulk: the `{ time, amplitude }` objects built
-//! by one small JavaScript function from a `Float64Array`, instead of by serde-wasm-bindgen's
-//! serializer, which crosses the boundary five or six times per impulse (an object, two keys,
-//! two numbers, two property sets). A page frame with six modes returns ~20 500 impulses
-//! (ZV-D³ over six modes alone has 15 625): through serde they took ~4.5 ms of the frame
-//! (docs/page-performance.md, *2026-12-07*), built here well under 1 ms.
+//! by one small JavaScript function from a view of the module's memory, instead of by
+//! serde-wasm-bindgen's serializer, which crosses the boundary five or six times per impulse
+//! (an object, two keys, two numbers, two property sets). A page frame with six modes returns
+//! ~20 500 impulses (ZV-D³ over six modes alone has 15 625): through serde they took ~4.5 ms
+//! of the frame (docs/page-performance.md, *2026-12-07*); the builder takes ~0.2 ms.
 //!
 //! The function is made once with the `Function` constructor. A page whose Content Security
 //! Policy forbids that (`unsafe-eval`) gets the constructor's exception, caught: the shaper is
