@@ -57,3 +57,42 @@ test('six modes with ZV, ZVD, ZVDD and ZV-D³ (15 625 impulses, kept factored) d
   assert.deepEqual(problems, []);
   await page.close();
 });
+
+// The frame's shapers are handed to the page by a small function made with the `Function`
+// constructor (crate/js/bulk.rs). A page served with a Content Security Policy that forbids it
+// (`script-src 'self' 'wasm-unsafe-eval'`: wasm allowed, eval not) must get the same frame from
+// serde's path: the same summary and impulse tables as without the policy, no error.
+test('under a CSP that forbids eval, six modes give the same frame', async () => {
+  const hash = `#state=${encodeURIComponent(JSON.stringify(STATE))}`;
+  const tables = (page) => page.$$eval('#summary tbody tr, [id^="impulses-"] tbody tr',
+    (rows) => rows.map((r) => r.textContent));
+  const { page: plain } = await env.page({ hash });
+  await settle(plain);
+  const want = await tables(plain);
+  await plain.close();
+  const page = await env.browserPage();
+  const problems = [];
+  page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
+  page.on('pageerror', (e) => problems.push(`pageerror: ${e.message}`));
+  await page.route(/\/(index\.html)?$/, async (route) => {
+    const response = await route.fetch();
+    await route.fulfill({
+      response,
+      headers: { ...response.headers(), 'content-security-policy': "script-src 'self' 'wasm-unsafe-eval'" },
+    });
+  });
+  await page.addInitScript(() => {
+    window.__violations = [];
+    document.addEventListener('securitypolicyviolation', (e) => window.__violations.push(e.blockedURI));
+  });
+  const response = await page.goto(env.url + hash);
+  assert.equal(response.headers()['content-security-policy'], "script-src 'self' 'wasm-unsafe-eval'");
+  await page.waitForSelector('body[data-ready="true"]', { timeout: 20000 });
+  await settle(page);
+  // The policy is in force: the module's `new Function` was refused (and said so on the console).
+  assert.ok((await page.evaluate(() => window.__violations)).includes('eval'), 'eval refused');
+  assert.ok(want.length > 20, `${want.length} rows`);
+  assert.deepEqual(await tables(page), want);
+  assert.deepEqual(problems.filter((p) => !/unsafe-eval/.test(p)), []);
+  await page.close();
+});
