@@ -646,7 +646,7 @@ fn a_response_cut_off_by_the_sweeps_end_is_reported() {
 /// the end. The resonances file reported a line between its last two bins, 130.45 Hz with
 /// ζ 0.00001, until a mode fitted back under the end had to raise the model at a fitted bin.
 /// The rise is reported at the last bin fitted before the cliff, 131.25 Hz (bins of 1.5625 Hz;
-/// the sweep ends at 133.33 Hz).
+/// the sweep ends at 133.33 Hz), with a note that says it may be the excitation's alone.
 #[test]
 fn a_file_without_modes_reports_none() {
     for file in [
@@ -660,6 +660,15 @@ fn a_file_without_modes_reports_none() {
         assert!(id.modes.is_empty(), "{file}: {:?}", id.modes);
         let cut = id.cut_off.expect("the rise into the end is reported");
         assert!((cut.frequency_hz - 131.2).abs() < 2.0, "{file}: {cut:?}");
+        // The note says the rise may be the excitation's alone (no mode under the end).
+        assert_eq!(id.notes.len(), 1, "{file}: {:?}", id.notes);
+        assert!(
+            id.notes[0].contains("no mode was found under it")
+                && id.notes[0].contains("the rise is the excitation's own")
+                && id.notes[0].contains("higher maximum frequency"),
+            "{file}: {}",
+            id.notes[0]
+        );
     }
 }
 

@@ -287,21 +287,32 @@ fn cut_off(past: Option<PastFit>, halves: &[HalfPower], top_hz: f64, near_hz: f6
     }
 }
 
-/// The user's note for [`Identification::cut_off`], when there is one.
-fn note_cut_off(result: &mut Identification) {
+/// The user's note for [`Identification::cut_off`], when there is one. With no mode found
+/// under the end (`none_found`), the rise may be the excitation's alone (a stiff machine's PSD
+/// rises as the drive's f² into the end: the test set's `rigid133`), and the note says so.
+fn note_cut_off(result: &mut Identification, none_found: bool) {
     if let Some(c) = result.cut_off {
-        result.notes.push(format!(
-            "The response still rises where the sweep ends ({:.1} Hz, {:.0} dB over its left \
-             flank): a mode peaks near or past the end, its frequency and damping cannot be \
-             read from this {}. Re-run the test with a higher maximum frequency.",
-            c.frequency_hz,
-            c.prominence_db,
-            if result.sweep.is_some() {
-                "recording"
-            } else {
-                "file"
-            }
-        ));
+        let what = if result.sweep.is_some() {
+            "recording"
+        } else {
+            "file"
+        };
+        let (f, db) = (c.frequency_hz, c.prominence_db);
+        result.notes.push(if none_found {
+            format!(
+                "The response still rises where the sweep ends ({f:.1} Hz, {db:.0} dB over its \
+                 left flank) and no mode was found under it: a mode peaks near or past the end, \
+                 or the machine has none in this {what}'s band and the rise is the excitation's \
+                 own. Re-run the test with a higher maximum frequency to tell which."
+            )
+        } else {
+            format!(
+                "The response still rises where the sweep ends ({f:.1} Hz, {db:.0} dB over its \
+                 left flank): a mode peaks near or past the end, its frequency and damping \
+                 cannot be read from this {what}. Re-run the test with a higher maximum \
+                 frequency."
+            )
+        });
     }
 }
 
@@ -703,7 +714,7 @@ pub fn identify(signal: &[f64], options: &IdentifyOptions) -> Result<Identificat
             frequency_hz: s.band_hz[1],
             prominence_db: r.prominence_db,
         });
-        note_cut_off(&mut result);
+        note_cut_off(&mut result, slots.is_empty());
     }
     if joint.is_none() && !halves.is_empty() {
         let bin = |f: f64| ((f / psd.resolution_hz).round() as usize).min(psd.psd.len() - 1);
@@ -835,7 +846,7 @@ pub fn identify_spectrum(
             frequency_hz: f_hi,
             prominence_db,
         });
-    note_cut_off(&mut result);
+    note_cut_off(&mut result, slots.is_empty());
     result.modes = slots.into_iter().map(Slot::into_mode).collect();
     crate::sort::sort_by(&mut result.modes, |a, b| {
         a.frequency_hz.total_cmp(&b.frequency_hz)
