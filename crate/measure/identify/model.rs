@@ -584,9 +584,13 @@ impl Problem<'_> {
 
     /// How far mode i stands over the model without it, at its frequency, dB.
     fn standing_db(&self, x: &[f64], m: usize, i: usize) -> f64 {
-        let fi = x[3 * i].exp();
+        self.standing_db_at(x, m, i, x[3 * i].exp())
+    }
+
+    /// How far mode i raises the model over the model without it at `f`, dB.
+    fn standing_db_at(&self, x: &[f64], m: usize, i: usize, f: f64) -> f64 {
         let without = without_mode(x, i);
-        10.0 * (self.level(x, m, fi) / self.level(&without, m, fi).max(1e-300)).log10()
+        10.0 * (self.level(x, m, f) / self.level(&without, m, f).max(1e-300)).log10()
     }
 }
 
@@ -1232,12 +1236,7 @@ pub(crate) fn fit_modes(input: &ModelInput, seeds: &[Seed], max_modes: usize) ->
     }
     let top = setup.range.1;
     let top_db = (0..seeds.len())
-        .map(|i| {
-            let without = without_mode(&best.0.x, i);
-            let m = seeds.len();
-            10.0 * (problem.level(&best.0.x, m, top) / problem.level(&without, m, top).max(1e-300))
-                .log10()
-        })
+        .map(|i| problem.standing_db_at(&best.0.x, seeds.len(), i, top))
         .collect();
     Some(Fitted {
         modes: modes_of(problem, &best.0, best.1, &seeds, setup.range),
