@@ -845,8 +845,9 @@ mod tests {
             designed(ShaperSpec::Umzv, &[3.0]),
             // Half of each jump at 0 and 0.09375 s: the trapezoid's first two knots' sum cancels.
             impulses(&[(0.0, 0.5), (0.09375, 0.5)]),
-            // At the trapezoid's knot spacing (its acceleration lasts 0.09375 s, its cruise
-            // 1.24 s): knots of different runs on the same time, merged.
+            // At the trapezoid's own knots (0, t_a, t_a + t_c, 2t_a + t_c with t_a = v/a =
+            // 0.75/8 = 0.09375 s and t_c = (d − v²/a)/v = 1.2395833… s): knots of different
+            // runs on the same time, merged.
             impulses(&[
                 (0.0, 0.25),
                 (0.09375, 0.25),
