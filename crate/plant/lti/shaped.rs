@@ -14,7 +14,10 @@
 //!
 //! The last sum's terms Aᵢ e^{−p tᵢ} are products over the factors (e^{−p(a+b)} = e^{−pa}e^{−pb}),
 //! formed once per shaper and mode by one complex multiplication per impulse instead of an
-//! exponential, a sine and a cosine per knot and mode. The command's own samples (its Taylor
+//! exponential, a sine and a cosine per knot and mode. The factor e^{p(t_s − τ_k)} is itself
+//! a product, e^{p·jT} · e^{p(s_k T − τ_k)} (s_k the knot's first sample, j = s − s_k): a
+//! table over j shared by the knots, and one value per knot and mode; and the particular
+//! solution Q is the knot's, not the sample's. The command's own samples (its Taylor
 //! state, for the feedthrough rows) take the moments too. The rest — each mode marched over the
 //! samples, the output rows — is [`Lti::respond`]'s own. Same response to rounding (tested
 //! against the expanded command in `tests/shaped_response.rs`).
@@ -212,10 +215,31 @@ fn sample(
     let mut dw = vec![0.0; samples * q];
     let mut jump = vec![0.0; samples * n];
     let mut any_jump = vec![false; samples];
-    let mut c = vec![0.0; q + 2];
+    // Per mode, the particular solution of the knot's polynomial (q + 2 coefficients): the same
+    // at every sample the knot's impulses land on.
+    let mut cs = vec![0.0; nm * (q + 2)];
+    // e^{p(t_s − τ_k)} at a sample s the knot at τ_k reaches, as e^{p·jT} · e^{p(s_k T − τ_k)}
+    // with s_k the knot's first sample and j = s − s_k: the first factor from a table shared
+    // by every knot (j ≤ the shaper's span over T, + 2), the second once per knot and mode.
+    // Both have σ ≤ 0 and arguments ≥ 0, so neither overflows.
+    let span = sums.times.iter().fold(0.0_f64, |a, &t| a.max(t));
+    let reach = ((span / period).ceil() as usize)
+        .saturating_add(3)
+        .min(samples);
+    let table: Vec<[f64; 2]> = (0..reach)
+        .flat_map(|j| modes.iter().map(move |m| pole_exp(m, j as f64 * period)))
+        .collect();
+    let mut lead = vec![[0.0; 2]; nm];
     for knot in knots {
-        bucket.iter_mut().for_each(|v| *v = 0.0);
-        hit.iter_mut().for_each(|h| *h = false);
+        let jumps = &knot.jumps[..q.min(ORDER)];
+        for (mode, c) in modes.iter().zip(cs.chunks_exact_mut(q + 2)) {
+            particular(mode, jumps, c);
+        }
+        let first = first_sample(knot.time, period);
+        let delta = first as f64 * period - knot.time;
+        for (mode, l) in modes.iter().zip(lead.iter_mut()) {
+            *l = pole_exp(mode, delta);
+        }
         for (i, (&t, &a)) in sums.times.iter().zip(sums.amps).enumerate() {
             let time = knot.time + t;
             let Some(s) = sample_at(time, period, samples) else {
@@ -237,8 +261,11 @@ fn sample(
                 z[1] += e[1];
             }
         }
-        let jumps = &knot.jumps[..q.min(ORDER)];
-        for s in (0..samples).filter(|&s| hit[s]) {
+        for s in 0..samples {
+            // Each row used is read once and emptied for the next knot.
+            if !std::mem::take(&mut hit[s]) {
+                continue;
+            }
             let row = &bucket[s * width..(s + 1) * width];
             let (moments, z) = row.split_at(q);
             // The command: Δw_m = Σ_l J_{m+l} M_l / l!.
@@ -251,19 +278,28 @@ fn sample(
                     *d += jumps.get(m + l).copied().unwrap_or(0.0) * mo * f;
                 }
             }
-            let back = s as f64 * period - knot.time;
+            let j = s - first;
+            let after = table.get(j * nm..(j + 1) * nm);
             any_jump[s] = true;
             let out = &mut jump[s * n..(s + 1) * n];
-            for (mode, zm) in modes.iter().zip(z.chunks_exact(2)) {
-                particular(mode, jumps, &mut c);
+            for (k, ((mode, zm), c)) in modes
+                .iter()
+                .zip(z.chunks_exact(2))
+                .zip(cs.chunks_exact(q + 2))
+                .enumerate()
+            {
                 let y = c.iter().zip(moments).map(|(c, m)| c * m).sum::<f64>();
                 let dy = (1..q)
                     .map(|m| m as f64 * c[m] * moments[m - 1])
                     .sum::<f64>();
                 // Σ Aᵢ e^{p vᵢ} = e^{p(t_s − τ_k)} · Σ Aᵢ e^{−p tᵢ}.
-                let w = (mode.sigma * back).exp();
-                let (sn, cs) = (mode.omega_d * back).sin_cos();
-                let (er, ei) = (w * cs, w * sn);
+                let [er, ei] = match after {
+                    Some(row) => {
+                        let ([a, b], [c, d]) = (row[k], lead[k]);
+                        [a * c - b * d, a * d + b * c]
+                    }
+                    None => pole_exp(mode, s as f64 * period - knot.time),
+                };
                 let (re, im) = (er * zm[0] - ei * zm[1], er * zm[1] + ei * zm[0]);
                 // e^{Av} r summed: Re·r + Im·(A − σI)r/ω_d, r = −(Q(0), Q'(0)).
                 let (r0, r1) = (-c[0], -c[1]);
@@ -272,6 +308,7 @@ fn sample(
                 out[mode.start] += y + re * r0 + im * b0 / mode.omega_d;
                 out[mode.start + 1] += dy + re * r1 + im * b1 / mode.omega_d;
             }
+            bucket[s * width..(s + 1) * width].fill(0.0);
         }
     }
     assemble(&dw, &jump, &any_jump, (q, n), period)
@@ -318,14 +355,26 @@ fn assemble(
 /// The first sample t_s = s·`period` at or after `time` (where [`Lti::respond`] takes a knot
 /// in), if there is one.
 fn sample_at(time: f64, period: f64, samples: usize) -> Option<usize> {
+    Some(first_sample(time, period)).filter(|&s| s < samples)
+}
+
+/// The first s ≥ 0 with s·`period` ≥ `time` (past the samples too).
+fn first_sample(time: f64, period: f64) -> usize {
     let mut s = (time / period).ceil().max(0.0) as usize;
     if s > 0 && ((s - 1) as f64 * period) >= time {
         s -= 1;
     }
     if (s as f64 * period) < time {
-        s += 1;
+        s = s.saturating_add(1);
     }
-    (s < samples).then_some(s)
+    s
+}
+
+/// e^{p·v} as (re, im) for the pole p = σ + iω_d.
+fn pole_exp(mode: &ModeBlock, v: f64) -> [f64; 2] {
+    let w = (mode.sigma * v).exp();
+    let (sn, cn) = (mode.omega_d * v).sin_cos();
+    [w * cn, w * sn]
 }
 
 /// The particular solution Q(v) = Σ cₘ vᵐ of y'' + 2ζω y' + ω²y = g Σₘ Jₘ vᵐ/m!, written into
