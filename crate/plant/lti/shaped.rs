@@ -220,25 +220,20 @@ fn sample(
     let mut cs = vec![0.0; nm * (q + 2)];
     // e^{p(t_s − τ_k)} at a sample s the knot at τ_k reaches, as e^{p·jT} · e^{p(s_k T − τ_k)}
     // with s_k the knot's first sample and j = s − s_k: the first factor from a table shared
-    // by every knot (j ≤ the shaper's span over T, + 2), the second once per knot and mode.
-    // Both have σ ≤ 0 and arguments ≥ 0, so neither overflows.
-    let span = sums.times.iter().fold(0.0_f64, |a, &t| a.max(t));
-    let reach = ((span / period).ceil() as usize)
-        .saturating_add(3)
-        .min(samples);
-    let table: Vec<[f64; 2]> = (0..reach)
-        .flat_map(|j| modes.iter().map(move |m| pole_exp(m, j as f64 * period)))
-        .collect();
-    let mut lead = vec![[0.0; 2]; nm];
+    // by the knots (filled as far as a knot reaches), the second once per knot and mode, each
+    // (re, im) per mode. Both have σ ≤ 0 and arguments ≥ 0, so neither overflows.
+    let mut table: Vec<f64> = Vec::new();
+    let mut lead = vec![0.0; 2 * nm];
     for knot in knots {
         let jumps = &knot.jumps[..q.min(ORDER)];
         for (mode, c) in modes.iter().zip(cs.chunks_exact_mut(q + 2)) {
             particular(mode, jumps, c);
         }
-        let first = first_sample(knot.time, period);
+        // Past the samples too (none of its impulses then lands on one).
+        let first = sample_at(knot.time, period, usize::MAX).unwrap_or(usize::MAX);
         let delta = first as f64 * period - knot.time;
-        for (mode, l) in modes.iter().zip(lead.iter_mut()) {
-            *l = pole_exp(mode, delta);
+        for (mode, l) in modes.iter().zip(lead.chunks_exact_mut(2)) {
+            l.copy_from_slice(&pole_exp(mode, delta));
         }
         for (i, (&t, &a)) in sums.times.iter().zip(sums.amps).enumerate() {
             let time = knot.time + t;
@@ -279,27 +274,28 @@ fn sample(
                 }
             }
             let j = s - first;
-            let after = table.get(j * nm..(j + 1) * nm);
+            while table.len() < 2 * nm * (j + 1) {
+                let v = (table.len() / (2 * nm)) as f64 * period;
+                for mode in modes {
+                    table.extend_from_slice(&pole_exp(mode, v));
+                }
+            }
+            let after = &table[2 * nm * j..2 * nm * (j + 1)];
             any_jump[s] = true;
             let out = &mut jump[s * n..(s + 1) * n];
-            for (k, ((mode, zm), c)) in modes
+            for ((((mode, zm), c), e), l) in modes
                 .iter()
                 .zip(z.chunks_exact(2))
                 .zip(cs.chunks_exact(q + 2))
-                .enumerate()
+                .zip(after.chunks_exact(2))
+                .zip(lead.chunks_exact(2))
             {
                 let y = c.iter().zip(moments).map(|(c, m)| c * m).sum::<f64>();
                 let dy = (1..q)
                     .map(|m| m as f64 * c[m] * moments[m - 1])
                     .sum::<f64>();
                 // Σ Aᵢ e^{p vᵢ} = e^{p(t_s − τ_k)} · Σ Aᵢ e^{−p tᵢ}.
-                let [er, ei] = match after {
-                    Some(row) => {
-                        let ([a, b], [c, d]) = (row[k], lead[k]);
-                        [a * c - b * d, a * d + b * c]
-                    }
-                    None => pole_exp(mode, s as f64 * period - knot.time),
-                };
+                let (er, ei) = (e[0] * l[0] - e[1] * l[1], e[0] * l[1] + e[1] * l[0]);
                 let (re, im) = (er * zm[0] - ei * zm[1], er * zm[1] + ei * zm[0]);
                 // e^{Av} r summed: Re·r + Im·(A − σI)r/ω_d, r = −(Q(0), Q'(0)).
                 let (r0, r1) = (-c[0], -c[1]);
@@ -355,22 +351,18 @@ fn assemble(
 /// The first sample t_s = s·`period` at or after `time` (where [`Lti::respond`] takes a knot
 /// in), if there is one.
 fn sample_at(time: f64, period: f64, samples: usize) -> Option<usize> {
-    Some(first_sample(time, period)).filter(|&s| s < samples)
-}
-
-/// The first s ≥ 0 with s·`period` ≥ `time` (past the samples too).
-fn first_sample(time: f64, period: f64) -> usize {
     let mut s = (time / period).ceil().max(0.0) as usize;
     if s > 0 && ((s - 1) as f64 * period) >= time {
         s -= 1;
     }
     if (s as f64 * period) < time {
-        s = s.saturating_add(1);
+        s += 1;
     }
-    s
+    (s < samples).then_some(s)
 }
 
 /// e^{p·v} as (re, im) for the pole p = σ + iω_d.
+#[inline(never)]
 fn pole_exp(mode: &ModeBlock, v: f64) -> [f64; 2] {
     let w = (mode.sigma * v).exp();
     let (sn, cn) = (mode.omega_d * v).sin_cos();
