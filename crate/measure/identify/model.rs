@@ -1545,6 +1545,21 @@ mod tests {
         assert!(checked >= 27, "{checked}");
     }
 
+    /// `body` given the bins of a 128 s sweep's periodogram (1/128 Hz apart, to 200 Hz) and its
+    /// model input (flat PSD, rectangular window, acceleration).
+    fn on_long_sweep(body: impl FnOnce(&[f64], &ModelInput)) {
+        let f: Vec<f64> = (0..25_600).map(|k| k as f64 / 128.0).collect();
+        let psd = vec![1.0; f.len()];
+        let input = input_on(
+            &f,
+            &psd,
+            WindowKind::Rectangular,
+            SignalKind::Acceleration,
+            None,
+        );
+        body(&f, &input);
+    }
+
     /// [`Problem::resolved`], the rule on a new mode in a sweep's periodogram, on a 128 s
     /// sweep's bins (1/128 Hz) fitted densely at 38–41 Hz and every 8th elsewhere, as
     /// `fit_bins` thins them away from the seeds. The case it was made for: ζ 0.0004 at
@@ -1554,38 +1569,31 @@ mod tests {
     /// anywhere.
     #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
     fn a_sweeps_new_mode_must_hold_two_fitted_bins() {
-        let df = 1.0 / 128.0;
-        let f: Vec<f64> = (0..25_600).map(|k| k as f64 * df).collect();
-        let psd = vec![1.0; f.len()];
-        let input = input_on(
-            &f,
-            &psd,
-            WindowKind::Rectangular,
-            SignalKind::Acceleration,
-            None,
-        );
-        let bins: Vec<usize> = (1280..19_200)
-            .filter(|&k| (38.0..=41.0).contains(&f[k]) || k % 8 == 0)
-            .collect();
-        let problem = problem_on(&input, &bins, 40.0);
-        let held = |fk: f64, zk: f64| {
-            bins.iter()
-                .filter(|&&b| (f[b] - fk).abs() <= zk * fk)
-                .count()
-        };
-        // The line of the 128 s sweep: wide enough, on one thinned bin.
-        assert!(2.0 * 0.0004 * 30.74 >= df);
-        assert_eq!(held(30.74, 0.0004), 1);
-        assert!(!problem.resolved(30.74, 0.0004));
-        // The same width among the dense bins.
-        assert!(held(39.5, 0.0004) >= 4);
-        assert!(problem.resolved(39.5, 0.0004));
-        // A broad mode among the thinned bins.
-        assert!(problem.resolved(30.74, 0.01));
-        // Narrower than a bin: never resolved, even on dense bins.
-        for fk in [39.5, 39.503, 39.5039] {
-            assert!(!problem.resolved(fk, 0.00005), "{fk}");
-        }
+        on_long_sweep(|f, input| {
+            let df = f[1];
+            let bins: Vec<usize> = (1280..19_200)
+                .filter(|&k| (38.0..=41.0).contains(&f[k]) || k % 8 == 0)
+                .collect();
+            let problem = problem_on(input, &bins, 40.0);
+            let held = |fk: f64, zk: f64| {
+                bins.iter()
+                    .filter(|&&b| (f[b] - fk).abs() <= zk * fk)
+                    .count()
+            };
+            // The line of the 128 s sweep: wide enough, on one thinned bin.
+            assert!(2.0 * 0.0004 * 30.74 >= df);
+            assert_eq!(held(30.74, 0.0004), 1);
+            assert!(!problem.resolved(30.74, 0.0004));
+            // The same width among the dense bins.
+            assert!(held(39.5, 0.0004) >= 4);
+            assert!(problem.resolved(39.5, 0.0004));
+            // A broad mode among the thinned bins.
+            assert!(problem.resolved(30.74, 0.01));
+            // Narrower than a bin: never resolved, even on dense bins.
+            for fk in [39.5, 39.503, 39.5039] {
+                assert!(!problem.resolved(fk, 0.00005), "{fk}");
+            }
+        });
     }
 
     /// [`Problem::others_stand`], the rule against a new mode displacing an old one, on the
@@ -1596,42 +1604,34 @@ mod tests {
     /// and the broad mode, were it the old one, stands over a notch 0.11 Hz away.
     #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
     fn a_new_mode_may_not_leave_an_old_one_standing_under_the_rest() {
-        let df = 1.0 / 128.0;
-        let f: Vec<f64> = (0..25_600).map(|k| k as f64 * df).collect();
-        let psd = vec![1.0; f.len()];
-        let input = input_on(
-            &f,
-            &psd,
-            WindowKind::Rectangular,
-            SignalKind::Acceleration,
-            None,
-        );
-        let bins: Vec<usize> = (3840..6400).collect();
-        let problem = problem_on(&input, &bins, 40.0);
-        // At resonance a mode's term is g/(2iζ) (power 2, f = fᵢ): the broad mode's at
-        // 39.17 Hz is about −i·26 (|1 − (39.17/39.06)²| = 0.0056 ≪ 2ζ = 0.038), and the old
-        // mode's gain −0.9·26·2·0.0001 cancels nine tenths of it.
-        let model = |g0: f64| {
-            vec![
-                39.17f64.ln(),
-                0.0001f64.ln(),
-                g0,
-                39.06f64.ln(),
-                0.0189f64.ln(),
-                1.0,
-                0.0,
-                0.0,
-                1e-6f64.ln(),
-            ]
-        };
-        let notch = model(-0.9 * 26.0 * 2.0 * 0.0001);
-        let standing = problem.standing_db(&notch, 2, 0);
-        assert!((-25.0..-15.0).contains(&standing), "{standing}");
-        assert!(!problem.others_stand(&notch, 2, &[1]));
-        assert!(problem.others_stand(&notch, 2, &[0]));
-        assert!(problem.others_stand(&notch, 2, &[0, 1]));
-        let peak = model(0.9 * 26.0 * 2.0 * 0.0001);
-        assert!(problem.standing_db(&peak, 2, 0) > 3.0);
-        assert!(problem.others_stand(&peak, 2, &[1]));
+        on_long_sweep(|_, input| {
+            let bins: Vec<usize> = (3840..6400).collect();
+            let problem = problem_on(input, &bins, 40.0);
+            // At resonance a mode's term is g/(2iζ) (power 2, f = fᵢ): the broad mode's at
+            // 39.17 Hz is about −i·26 (|1 − (39.17/39.06)²| = 0.0056 ≪ 2ζ = 0.038), and the old
+            // mode's gain −0.9·26·2·0.0001 cancels nine tenths of it.
+            let model = |g0: f64| {
+                vec![
+                    39.17f64.ln(),
+                    0.0001f64.ln(),
+                    g0,
+                    39.06f64.ln(),
+                    0.0189f64.ln(),
+                    1.0,
+                    0.0,
+                    0.0,
+                    1e-6f64.ln(),
+                ]
+            };
+            let notch = model(-0.9 * 26.0 * 2.0 * 0.0001);
+            let standing = problem.standing_db(&notch, 2, 0);
+            assert!((-25.0..-15.0).contains(&standing), "{standing}");
+            assert!(!problem.others_stand(&notch, 2, &[1]));
+            assert!(problem.others_stand(&notch, 2, &[0]));
+            assert!(problem.others_stand(&notch, 2, &[0, 1]));
+            let peak = model(0.9 * 26.0 * 2.0 * 0.0001);
+            assert!(problem.standing_db(&peak, 2, 0) > 3.0);
+            assert!(problem.others_stand(&peak, 2, &[1]));
+        });
     }
 }
