@@ -85,12 +85,15 @@ fn read<T: DeserializeOwned + std::fmt::Debug>(
 
 /// Writes `value` to a plain JS object (maps as objects, not `Map`).
 pub(crate) fn to_js<T: Serialize>(value: &T) -> Result<JsValue, JsValue> {
+    serialized(value).map_err(js_error)
+}
+
+/// [`to_js`] with the error as the crate's.
+pub(crate) fn serialized<T: Serialize>(value: &T) -> Result<JsValue, Error> {
     value
         .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
-        .map_err(|e| {
-            js_error(Error::Render {
-                reason: e.to_string(),
-            })
+        .map_err(|e| Error::Render {
+            reason: e.to_string(),
         })
 }
 

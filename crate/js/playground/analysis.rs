@@ -5,21 +5,19 @@
 use super::state::Frame;
 use crate::design::{self, ShaperSpec};
 use crate::error::Error;
-use crate::metrics::Metrics;
 use crate::mode::{Mode, ModeSpec};
 use crate::robustness::RobustnessRow;
 use crate::shaper::{Shaper, ShaperData};
 use crate::vibration;
 use serde::Serialize;
 use std::cell::RefCell;
+use std::rc::Rc;
 
-/// Everything the page shows about one shaper.
-#[derive(Serialize, Clone)]
-#[serde(rename_all = "camelCase")]
+/// Everything the page shows about one shaper but the simulated move's metrics (the frame's
+/// result adds those: `ResultOut` in `mod.rs`).
 pub(super) struct ShaperResult {
     pub label: String,
     pub family: &'static str,
-    #[serde(serialize_with = "crate::js::bulk::serialize_shaper")]
     pub shaper: ShaperData,
     pub sensitivity: vibration::SensitivityCurve,
     pub insensitivity: Vec<vibration::Insensitivity>,
@@ -28,8 +26,6 @@ pub(super) struct ShaperResult {
     /// `None` (JS `null`) for shapers whose amplitudes sum to zero (bang-bang, on/off):
     /// Klipper's smoothing divides by that sum.
     pub klipper: Option<crate::smoothing::KlipperFigures>,
-    /// Metrics of the shaped move on the simulated (mismatched) plant.
-    pub simulation: Option<Metrics>,
     /// A `sampled` shaper's cost report (Kamel, Lange & Hirzinger; `sampledReport` without the
     /// impulses); `None` for the other families and for a sampled shaper designed elsewhere (an
     /// amplitude or increment bound: its minimum-norm baseline needs the solver).
@@ -37,7 +33,7 @@ pub(super) struct ShaperResult {
 }
 
 /// The cost report of a `sampled` shaper on the page: `sampledReport`'s figures.
-#[derive(Serialize, Clone)]
+#[derive(Serialize)]
 #[serde(rename_all = "camelCase")]
 pub(super) struct SampledFigures {
     /// τ of eq. 10, s.
@@ -51,14 +47,15 @@ pub(super) struct SampledFigures {
 }
 
 /// The part of a frame that depends on the designs and the analysis settings only, not on the
-/// simulated plant, the mismatch or the command: what [`ANALYSIS`] keeps between frames.
-#[derive(Clone)]
+/// simulated plant, the mismatch or the command: what [`ANALYSIS`] keeps between frames, shared
+/// with the frames that take it (never copied: a six-mode frame's shapers hold ~20 000
+/// impulses, twice).
 pub(super) struct Analysis {
     /// Which computation this is (a counter): the same number on every frame that takes it
     /// from [`ANALYSIS`], so the charts drawn from it alone need not be drawn again.
     pub generation: u64,
     pub shapers: Vec<Shaper>,
-    /// Per shaper, everything but the simulation's metrics (`simulation` is `None`).
+    /// Per shaper, everything but the simulation's metrics.
     pub results: Vec<ShaperResult>,
     /// V(ζ) of every shaper at mode 1, if the damping chart is drawn.
     pub damping_curves: Option<Vec<vibration::DampingSensitivityCurve>>,
@@ -87,19 +84,19 @@ thread_local! {
     /// The last frame's [`Analysis`] and its key. Dragging the mismatch, or editing the
     /// command or the plant, changes only the simulation: the designs, I(Vtol), V(f), V(ζ),
     /// the map and |S(f)| are taken from here instead of being recomputed every frame.
-    static ANALYSIS: RefCell<Option<(AnalysisKey, Analysis)>> = const { RefCell::new(None) };
+    static ANALYSIS: RefCell<Option<(AnalysisKey, Rc<Analysis>)>> = const { RefCell::new(None) };
     /// The last [`Analysis::generation`] handed out.
     static GENERATION: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
 /// The designs and their analyses for a frame, from [`ANALYSIS`] when nothing they depend on
 /// changed. Errors carry the same fields as when computed directly (they are never cached).
-pub(super) fn analysis(frame: &Frame) -> Result<Analysis, Error> {
+pub(super) fn analysis(frame: &Frame) -> Result<Rc<Analysis>, Error> {
     let key = AnalysisKey::of(frame);
     let cached = ANALYSIS.with_borrow(|c| {
         c.as_ref()
             .filter(|(k, _)| *k == key)
-            .map(|(_, a)| a.clone())
+            .map(|(_, a)| Rc::clone(a))
     });
     if let Some(a) = cached {
         return Ok(a);
@@ -109,7 +106,7 @@ pub(super) fn analysis(frame: &Frame) -> Result<Analysis, Error> {
     let in_view = |e: Error| e.within("view");
     let generation = GENERATION.get() + 1;
     GENERATION.set(generation);
-    let a = Analysis {
+    let a = Rc::new(Analysis {
         generation,
         damping_curves: damping_chart
             .then(|| damping_curves(frame, &shapers))
@@ -125,8 +122,8 @@ pub(super) fn analysis(frame: &Frame) -> Result<Analysis, Error> {
             .map_err(in_view)?,
         shapers,
         results,
-    };
-    ANALYSIS.with_borrow_mut(|c| *c = Some((key, a.clone())));
+    });
+    ANALYSIS.with_borrow_mut(|c| *c = Some((key, Rc::clone(&a))));
     Ok(a)
 }
 
@@ -205,7 +202,6 @@ fn designs(frame: &Frame) -> Result<(Vec<Shaper>, Vec<ShaperResult>), Error> {
                 .collect(),
             centroid_delay: shaper.centroid_delay(),
             klipper,
-            simulation: None,
             sampled,
         });
         shapers.push(shaper);

@@ -17,14 +17,13 @@ mod draw;
 mod simulation;
 mod state;
 
-use super::api::{js_error, to_js};
+use super::api::{js_error, serialized};
 use crate::error::Error;
 use crate::metrics::Metrics;
 use crate::mode::Mode;
 use crate::robustness::RobustnessRow;
 use crate::shaper::ShaperData;
 use crate::vibration;
-use analysis::ShaperResult;
 use serde::Serialize;
 use state::{Frame, ViewPlant};
 use wasm_bindgen::prelude::*;
@@ -44,17 +43,36 @@ struct SimulationSummary {
     unshaped: Metrics,
 }
 
+/// One shaper's entry of the result: its analysis (kept between frames) and its move's metrics
+/// (this frame's), the keys in the order they always had.
 #[derive(Serialize)]
 #[serde(rename_all = "camelCase")]
-struct PlaygroundResult {
+struct ResultOut<'a> {
+    label: &'a str,
+    family: &'static str,
+    #[serde(serialize_with = "crate::js::bulk::serialize_shaper")]
+    shaper: &'a ShaperData,
+    sensitivity: &'a vibration::SensitivityCurve,
+    insensitivity: &'a [vibration::Insensitivity],
+    residual_at_modes: &'a [f64],
+    centroid_delay: Option<f64>,
+    klipper: &'a Option<crate::smoothing::KlipperFigures>,
+    /// Metrics of the shaped move on the simulated (mismatched) plant.
+    simulation: Option<&'a Metrics>,
+    sampled: &'a Option<analysis::SampledFigures>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct PlaygroundResult<'a> {
     /// One entry per compared shaper, in order.
-    results: Vec<ShaperResult>,
+    results: Vec<ResultOut<'a>>,
     // The first shaper's figures, as the single-shaper page had them.
     #[serde(serialize_with = "crate::js::bulk::serialize_shaper")]
-    shaper: ShaperData,
-    sensitivity: vibration::SensitivityCurve,
-    insensitivity: Vec<vibration::Insensitivity>,
-    residual_at_modes: Vec<f64>,
+    shaper: &'a ShaperData,
+    sensitivity: &'a vibration::SensitivityCurve,
+    insensitivity: &'a [vibration::Insensitivity],
+    residual_at_modes: &'a [f64],
     centroid_delay: Option<f64>,
     /// The simulated move: plant, window and the unshaped command's metrics.
     simulation: SimulationSummary,
@@ -91,16 +109,14 @@ pub fn render_playground(
     #[wasm_bindgen(unchecked_param_type = "PlaygroundState")] state: JsValue,
     #[wasm_bindgen(unchecked_optional_param_type = "PlaygroundCanvases | null")] canvases: JsValue,
 ) -> Result<JsValue, JsValue> {
-    frame(state, &canvases)
-        .map_err(js_error)
-        .and_then(|r| to_js(&r))
+    frame(state, &canvases).map_err(js_error)
 }
 
 /// One frame: read, analyse, simulate, draw, report.
-fn frame(state: JsValue, canvases: &JsValue) -> Result<PlaygroundResult, Error> {
+fn frame(state: JsValue, canvases: &JsValue) -> Result<JsValue, Error> {
     let frame = Frame::parse(state, canvases)?;
-    let mut analysis = analysis::analysis(&frame)?;
-    let sim = simulation::simulate(&frame, &mut analysis)?;
+    let analysis = analysis::analysis(&frame)?;
+    let sim = simulation::simulate(&frame, &analysis)?;
     let robustness = analysis::robustness_rows(&frame.modes[0], frame.view.vtol)
         .map_err(|e| e.within("view"))?;
     let spectra = simulation::command_spectra(&frame, &analysis, &sim.commands)?;
@@ -113,12 +129,29 @@ fn frame(state: JsValue, canvases: &JsValue) -> Result<PlaygroundResult, Error> 
             spectra: spectra.as_ref(),
         },
     )?;
+    let results: Vec<ResultOut<'_>> = analysis
+        .results
+        .iter()
+        .zip(&sim.shaped_metrics)
+        .map(|(r, m)| ResultOut {
+            label: &r.label,
+            family: r.family,
+            shaper: &r.shaper,
+            sensitivity: &r.sensitivity,
+            insensitivity: &r.insensitivity,
+            residual_at_modes: &r.residual_at_modes,
+            centroid_delay: r.centroid_delay,
+            klipper: &r.klipper,
+            simulation: Some(m),
+            sampled: &r.sampled,
+        })
+        .collect();
     let first = &analysis.results[0];
-    Ok(PlaygroundResult {
-        shaper: first.shaper.clone(),
-        sensitivity: first.sensitivity.clone(),
-        insensitivity: first.insensitivity.clone(),
-        residual_at_modes: first.residual_at_modes.clone(),
+    serialized(&PlaygroundResult {
+        shaper: &first.shaper,
+        sensitivity: &first.sensitivity,
+        insensitivity: &first.insensitivity,
+        residual_at_modes: &first.residual_at_modes,
         centroid_delay: first.centroid_delay,
         simulation: SimulationSummary {
             mismatch: frame.view.mismatch,
@@ -137,6 +170,6 @@ fn frame(state: JsValue, canvases: &JsValue) -> Result<PlaygroundResult, Error> 
         robustness,
         map_shaper: frame.view.map_shaper,
         damping_to: frame.damping_to,
-        results: analysis.results,
+        results,
     })
 }

@@ -20,17 +20,17 @@ pub(super) struct Simulation {
     /// The response to the reference command, and its metrics.
     pub unshaped: Trajectory,
     pub unshaped_metrics: Metrics,
-    /// The response to each shaper's command (its metrics go to the shaper's result).
+    /// The response to each shaper's command, and its metrics.
     pub shaped: Vec<Trajectory>,
+    pub shaped_metrics: Vec<Metrics>,
     /// The simulated plant's modes.
     pub plant_modes: Vec<Mode>,
     pub duration: f64,
     pub sample_period: f64,
 }
 
-/// Simulates the reference and every shaped command; writes each shaped move's metrics into
-/// `analysis.results`.
-pub(super) fn simulate(frame: &Frame, analysis: &mut Analysis) -> Result<Simulation, Error> {
+/// Simulates the reference and every shaped command, with each move's metrics.
+pub(super) fn simulate(frame: &Frame, analysis: &Analysis) -> Result<Simulation, Error> {
     let command = &frame.command;
     let commands = frame
         .specs
@@ -63,6 +63,7 @@ pub(super) fn simulate(frame: &Frame, analysis: &mut Analysis) -> Result<Simulat
     let unshaped_metrics =
         crate::metrics::metrics(&unshaped, command, command).map_err(|e| e.within("view"))?;
     let mut shaped = Vec::with_capacity(commands.len());
+    let mut shaped_metrics = Vec::with_capacity(commands.len());
     for (k, c) in commands.iter().enumerate() {
         // The reference shaped by a shaper: simulated from the shaper's convolution factors
         // (the same response to rounding, without a knot per impulse of the expanded shaper).
@@ -89,7 +90,7 @@ pub(super) fn simulate(frame: &Frame, analysis: &mut Analysis) -> Result<Simulat
             )?),
             _ => None,
         };
-        analysis.results[k].simulation = Some(
+        shaped_metrics.push(
             crate::metrics::metrics_with(&t, &figures[k], own.as_ref().unwrap_or(command))
                 .map_err(|e| e.within("view"))?,
         );
@@ -100,6 +101,7 @@ pub(super) fn simulate(frame: &Frame, analysis: &mut Analysis) -> Result<Simulat
         unshaped,
         unshaped_metrics,
         shaped,
+        shaped_metrics,
         plant_modes,
         duration,
         sample_period,
