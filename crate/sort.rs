@@ -22,8 +22,9 @@ pub(crate) fn sort_by<T>(v: &mut [T], cmp: impl Fn(&T, &T) -> Ordering) {
 /// Sorts `v` stably by an `f64` key in [`f64::total_cmp`]'s order, as
 /// `sort_by(v, |a, b| key(a).total_cmp(&key(b)))` does, by a least-significant-digit radix
 /// sort of the keys' bits (passes of a byte, a pass skipped where every key has the same
-/// byte; none where `v` is already sorted: [`radix_order`]): the impulse times of a 6-mode convolution (15 625)
-/// and the knots of a command shaped by it, in time order, without a comparison sort.
+/// byte; none where `v` is already sorted: [`radix_order`]): the impulse times of a 6-mode
+/// convolution (15 625) and the knots of a command shaped by it, in time order, without a
+/// comparison sort.
 pub(crate) fn sort_by_f64_key<T>(v: &mut [T], key: impl Fn(&T) -> f64) {
     let n = v.len();
     if n < 64 || u32::try_from(n).is_err() {

@@ -181,3 +181,64 @@ fn six_modes_zvdd_responds_as_its_expanded_command() {
     assert!(d > 0.0 && d < 1e-9, "factored response differs by {d:e}");
     eprintln!("six-mode ZVDD: relative difference {d:e}");
 }
+
+/// A window that ends inside the move: the later knots land past the last sample (their
+/// impulses are skipped, and a knot whose first sample lies past the window reads nothing of
+/// the response's table). The same response as the expanded command's.
+#[test]
+fn knots_past_the_samples_respond_as_the_expanded_command() {
+    let modes: Vec<Mode> = [2.0, 5.5]
+        .iter()
+        .map(|&f| Mode::new(f, 0.03).unwrap())
+        .collect();
+    let shaper = design_for(&ShaperSpec::Zvd, &modes).unwrap();
+    let plant: Vec<Mode> = modes
+        .iter()
+        .map(|m| Mode::new(m.frequency_hz() * 1.07, 0.05).unwrap())
+        .collect();
+    let participation = vec![0.5; 2];
+    let plant = Plant::Modal(ModalPlant::new(plant, participation).unwrap());
+    let late = &commands()[0];
+    let (period, duration) = (0.005, 0.6);
+    let factored = simulate_shaped(&plant, late, &shaper, period, duration).unwrap();
+    let expanded = simulate(&plant, &late.shaped(&shaper).unwrap(), period, duration).unwrap();
+    let d = difference(&factored, &expanded);
+    assert!(
+        d > 0.0 && d < 1e-9,
+        "a window ending inside the move differs by {d:e}"
+    );
+}
+
+/// `Lti::respond_shaped` takes factors with times from 0 (a shaper's): given a negative time
+/// it declines (`None`: the caller expands the command) instead of reading its table before
+/// its start.
+#[test]
+fn a_factor_with_a_negative_time_is_declined() {
+    let plant = ModalPlant::new(vec![Mode::new(3.0, 0.02).unwrap()], vec![1.0]).unwrap();
+    let Command::Piecewise(base) = &commands()[0] else {
+        panic!("a trapezoid is piecewise");
+    };
+    let factor = [
+        Impulse {
+            time: -0.1,
+            amplitude: 0.5,
+        },
+        Impulse {
+            time: 0.2,
+            amplitude: 0.5,
+        },
+    ];
+    let lti = plant.to_lti();
+    assert!(lti
+        .respond_shaped(base, &[&factor], 0.01, 300)
+        .unwrap()
+        .is_none());
+    let shifted = factor.map(|i| Impulse {
+        time: i.time + 0.1,
+        ..i
+    });
+    assert!(lti
+        .respond_shaped(base, &[&shifted], 0.01, 300)
+        .unwrap()
+        .is_some());
+}

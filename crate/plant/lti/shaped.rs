@@ -51,8 +51,9 @@ impl Lti {
     /// times from 0), at t = k·`sample_period`, k = 0 … `samples` − 1: the same as
     /// [`Lti::respond`] on `base` shaped by the expanded shaper, to rounding (the method is
     /// derived in `crate/plant/lti/shaped.rs`). `None` when the plant is not a set of modes driven by the position alone (the
-    /// modal plant), a mode is not underdamped, the sums would grow past e^300, or
-    /// `base` has more than 64 knots: then the caller expands the command.
+    /// modal plant), a mode is not underdamped, the sums would grow past e^300, a factor
+    /// holds a negative time, or `base` has more than 64 knots: then the caller expands the
+    /// command.
     pub fn respond_shaped(
         &self,
         base: &Piecewise,
@@ -72,7 +73,10 @@ impl Lti {
             .iter()
             .map(|m| -m.sigma * (span + sample_period))
             .fold(0.0_f64, f64::max);
-        let usable = growth.is_finite() && growth <= MAX_GROWTH && sample_period > 0.0;
+        // Times from 0 (a shaper's always are): a knot's impulses then land at or after its
+        // first sample, where the table of `sample` starts.
+        let from_zero = factors.iter().all(|f| f.iter().all(|i| i.time >= 0.0));
+        let usable = growth.is_finite() && growth <= MAX_GROWTH && sample_period > 0.0 && from_zero;
         if knots.len() > MAX_BASE_KNOTS || !usable || samples == 0 {
             return Ok(None);
         }
