@@ -69,12 +69,14 @@ impl Piecewise {
         }
         let mut sorted = knots;
         crate::sort::sort_by_f64_key(&mut sorted, |k| k.time);
-        let span = match (sorted.first(), sorted.last()) {
-            (Some(a), Some(b)) => merge_span(a.time, b.time),
-            _ => 0.0,
-        };
+        let tol = merge_tolerance(
+            sorted
+                .first()
+                .zip(sorted.last())
+                .map(|(a, b)| (a.time, b.time)),
+        );
         let mut merged = Vec::with_capacity(sorted.len());
-        merged.extend(MergedKnots::new(Box::new(sorted.into_iter()), span));
+        merged.extend(MergedKnots::new(Box::new(sorted.into_iter()), tol));
         let degree = merged
             .iter()
             .filter_map(|k| k.jumps.iter().rposition(|&j| j != 0.0))
@@ -193,11 +195,8 @@ impl Piecewise {
             return Ok(None);
         }
         let runs = ShapedRuns::new(&self.knots, shaper.impulses());
-        let span = match (runs.first_time(), runs.last_time()) {
-            (Some(a), Some(b)) => merge_span(a, b),
-            _ => 0.0,
-        };
-        Ok(Some(MergedKnots::new(Box::new(runs), span)))
+        let tol = runs.merge_tolerance();
+        Ok(Some(MergedKnots::new(Box::new(runs), tol)))
     }
 
     /// [`Piecewise::shaped_knots`] for a command of degree ≤ 2 (jumps in position, velocity and
@@ -215,13 +214,9 @@ impl Piecewise {
             return Ok(None);
         }
         let runs = ShapedRuns::new(&self.knots, shaper.impulses());
-        let span = match (runs.first_time(), runs.last_time()) {
-            (Some(a), Some(b)) => merge_span(a, b),
-            _ => 0.0,
-        };
         let mut steps = ShapedSteps {
+            tol: runs.merge_tolerance(),
             runs,
-            tol: (KNOT_MERGE * span).max(1e-15),
             pending: None,
         };
         steps.pending = steps.raw();
@@ -272,9 +267,14 @@ impl Piecewise {
     }
 }
 
-/// The span [`KNOT_MERGE`] is relative to, for knots from `first` to `last` (sorted).
-fn merge_span(first: f64, last: f64) -> f64 {
-    (last - first).abs().max(first.abs()).max(last.abs())
+/// How close knots from `first` to `last` (sorted; `None`: no knots) must be to be merged:
+/// [`KNOT_MERGE`] times their span (the largest of the distance between them and their
+/// magnitudes), at least 1e-15 s.
+fn merge_tolerance(ends: Option<(f64, f64)>) -> f64 {
+    let span = ends.map_or(0.0, |(first, last)| {
+        (last - first).abs().max(first.abs()).max(last.abs())
+    });
+    (KNOT_MERGE * span).max(1e-15)
 }
 
 /// The knots of a command shaped by an impulse sequence, in time order, not yet merged: one run
@@ -308,6 +308,11 @@ impl<'a> ShapedRuns<'a> {
     fn last_time(&self) -> Option<f64> {
         let t1 = self.impulses.last()?.time;
         self.runs.iter().map(|k| k.time + t1).reduce(f64::max)
+    }
+
+    /// [`merge_tolerance`] of the knots the runs give.
+    fn merge_tolerance(&self) -> f64 {
+        merge_tolerance(self.first_time().zip(self.last_time()))
     }
 }
 
@@ -399,11 +404,11 @@ pub(crate) struct MergedKnots<'a> {
 }
 
 impl<'a> MergedKnots<'a> {
-    fn new(mut sorted: Box<dyn Iterator<Item = Knot> + 'a>, span: f64) -> Self {
+    fn new(mut sorted: Box<dyn Iterator<Item = Knot> + 'a>, tol: f64) -> Self {
         let pending = sorted.next();
         MergedKnots {
             sorted,
-            tol: (KNOT_MERGE * span).max(1e-15),
+            tol,
             pending,
         }
     }
