@@ -222,7 +222,7 @@ pub fn piecewise_spectrum(p: &Piecewise, options: &SpectrumOptions) -> Result<Sp
                     }
                 }
             }
-            sum.0.hypot(sum.1)
+            crate::vibration::magnitude(sum.0, sum.1)
         })
         .collect();
     Ok(Spectrum {
@@ -302,7 +302,7 @@ pub fn sampled_spectrum(s: &Sampled, options: &SpectrumOptions) -> Result<Spectr
             if r != 1 {
                 vel = cmul(vel, i_omega_pow(w, r - 1));
             }
-            vel.0.hypot(vel.1)
+            crate::vibration::magnitude(vel.0, vel.1)
         })
         .collect();
     Ok(Spectrum {

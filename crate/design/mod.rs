@@ -528,7 +528,7 @@ fn verify_zero_moments(shaper: &Shaper, modes: &[Mode], derivatives: u32) -> Res
                 mode.damping(),
                 k,
             );
-            let m = c.hypot(s) / t_n.powi(k as i32);
+            let m = crate::vibration::magnitude(c, s) / t_n.powi(k as i32);
             if m.is_nan() || m > ZERO_VIBRATION_TOLERANCE {
                 return Err(Error::Infeasible {
                     reason: format!(

@@ -223,7 +223,7 @@ impl Setup<'_> {
                 Con::Limit(p) => {
                     let (w, _, m) = &sums.points[p];
                     let [c0, s0] = m[0];
-                    c0.hypot(s0) / self.vtol_of(&self.points[p], *w).0 - 1.0
+                    crate::vibration::magnitude(c0, s0) / self.vtol_of(&self.points[p], *w).0 - 1.0
                 }
                 Con::Stationary { point, coord } => {
                     let (w, z, m) = &sums.points[point];

@@ -212,7 +212,7 @@ pub(crate) struct Report {
 pub(crate) fn scaled_moment(imps: &[Impulse], omega: f64, zeta: f64, k: u32) -> f64 {
     let t_n = imps.last().map_or(0.0, |i| i.time).max(1e-300);
     let [c, s] = vibration_moment(imps, omega, zeta, k);
-    c.hypot(s) / t_n.powi(k as i32)
+    crate::vibration::magnitude(c, s) / t_n.powi(k as i32)
 }
 
 /// Checks a normalized design: sampled limits, zero constraints, and a dense scan of every band.

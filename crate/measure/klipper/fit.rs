@@ -438,7 +438,7 @@ pub fn vibration_at(impulses: &[crate::shaper::Impulse], a: f64, b: f64) -> f64 
             s += w * sin;
         }
     }
-    c.hypot(s)
+    crate::vibration::magnitude(c, s)
 }
 
 /// numpy's `arange(start, end, step)` for floats: ⌈(end − start)/step⌉ values
