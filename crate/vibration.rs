@@ -45,7 +45,7 @@ pub fn vibration_rad(impulses: &[Impulse], omega: f64, zeta: f64) -> f64 {
 /// neither square can overflow or lose its last bits to underflow (|c|, |s| between 2⁻⁴⁰⁰
 /// and 2⁴⁰⁰: every vibration phasor of a shaper) the plain formula, within an ulp or two of
 /// `hypot`; elsewhere `hypot` itself.
-#[inline]
+#[inline(never)]
 pub(crate) fn magnitude(c: f64, s: f64) -> f64 {
     const BIG: f64 = 2.582_249_878_086_908_6e120; // 2^400
     const SMALL: f64 = 1.0 / BIG;

@@ -55,7 +55,12 @@ fi
 # per axis in that worker. Measured 2026-12-04 (docs/measured-data.md, *Optimised shapers*,
 # *Speed*): node CPU time per axis about halved against "z" / `-Oz` (resonances_y_three.csv
 # 159 → 79 ms), opt-level 3 / `-O3` no faster, for 66.7 KB more gzip (255.0 → 321.7 KB).
-# The designer module stays at "z".
+# The whole API's module (pkg/input_shaping) and the design worker's (designer) are built for
+# speed as well, opt-level 2 and `wasm-opt -O2`: neither is part of the first load, and the
+# solved families' designs run in them (issue 24 item 1: `si` over three modes in Node,
+# I 0.3 216 -> 104 ms, I 0.7 1277 -> 746 ms, the same designs; opt-level 3 / `-O3` and
+# +simd128 no faster), for about 165 KB more gzip in the library's wasm (523.8 -> 689.3 KB)
+# (docs/benchmarks.md, *Solved families*, 2026-12-07).
 # The page's main-thread module builds its dependencies that no frame spends time in (std,
 # serde, serde-wasm-bindgen, nalgebra, ...) at "s" while the crate and the drawing path
 # (plotters, its canvas backend, web-sys, js-sys, wasm-bindgen) stay at 2 (DEPS_OPT below):
@@ -184,10 +189,10 @@ module() {
 mkdir -p pkg/page
 pids=()
 stale=0
-module js-api pkg input_shaping z z
+module js-api pkg input_shaping 2 2
 if [ "$what" != --library ]; then
   module js-playground pkg/page playground 2 2 s immediate-abort
-  module js-designer,solver pkg/page designer z z
+  module js-designer,solver pkg/page designer 2 2
   module js-recording pkg/page recording 2 2
   module js-corner pkg/page corner 2 2
 fi
