@@ -5,7 +5,7 @@
 //   bash scripts/build.sh --library          # this branch's pkg/input_shaping.js
 //   node benches/si_wasm.mjs OLD/input_shaping.js pkg/input_shaping.js
 //
-// Prints per build and case the median and minimum of RUNS (default 5) runs after one warm-up
+// ALL=1 adds the issue's other rows (see below). Prints per build and case the median and minimum of RUNS (default 5) runs after one warm-up
 // (wall clock), and the design's duration and impulse count (which must agree).
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
@@ -22,6 +22,14 @@ for (const m of modules) {
 }
 const modes = [1.2, 3.4, 7.9].map((f) => ({ frequencyHz: f, damping: 0.02 }));
 const cases = [0.3, 0.7].map((i) => ({ name: `si three modes I ${i}`, spec: { family: 'si', modes, vtol: 0.05, insensitivity: i } }));
+// ALL=1: the issue's other rows too (Peláez & Singhose's one-mode SI, `direct` ZVD over three
+// and six modes).
+if (process.env.ALL === '1') {
+  const six = [1.2, 3.4, 7.9, 13, 21, 34].map((f) => ({ frequencyHz: f, damping: 0.02 }));
+  cases.unshift({ name: 'si one mode (Peláez & Singhose) I 0.7', spec: { family: 'si', modes: [{ frequencyHz: 0.5, damping: 0.002 }], vtol: 0.05, insensitivity: 0.7 } });
+  cases.push({ name: 'direct ZVD three modes', spec: { family: 'direct', modes, derivatives: 1 } });
+  cases.push({ name: 'direct ZVD six modes', spec: { family: 'direct', modes: six, derivatives: 1 } });
+}
 for (const c of cases) {
   const times = loaded.map(() => []);
   const results = loaded.map(({ mod }) => mod.design(c.spec)); // warm-up
@@ -35,6 +43,6 @@ for (const c of cases) {
   loaded.forEach(({ name }, k) => {
     const s = [...times[k]].sort((a, b) => a - b);
     const res = results[k];
-    console.log(`${c.name} | ${name} | median ${s[s.length >> 1].toFixed(0)} ms, min ${s[0].toFixed(0)} ms | ${res.duration.toFixed(6)} s, ${res.impulses.length} impulses`);
+    console.log(`${c.name} | ${name} | median ${s[s.length >> 1].toFixed(1)} ms, min ${s[0].toFixed(1)} ms | ${res.duration.toFixed(6)} s, ${res.impulses.length} impulses`);
   });
 }
