@@ -32,17 +32,19 @@ if (process.env.ALL === '1') {
 }
 for (const c of cases) {
   const times = loaded.map(() => []);
-  const results = loaded.map(({ mod }) => mod.design(c.spec)); // warm-up
+  const attempt = (mod) => { try { return mod.design(c.spec); } catch (e) { return { error: e }; } };
+  const results = loaded.map(({ mod }) => attempt(mod)); // warm-up
   for (let r = 0; r < RUNS; r++) {
     loaded.forEach(({ mod }, k) => {
       const t0 = performance.now();
-      mod.design(c.spec);
+      attempt(mod);
       times[k].push(performance.now() - t0);
     });
   }
   loaded.forEach(({ name }, k) => {
     const s = [...times[k]].sort((a, b) => a - b);
     const res = results[k];
-    console.log(`${c.name} | ${name} | median ${s[s.length >> 1].toFixed(1)} ms, min ${s[0].toFixed(1)} ms | ${res.duration.toFixed(6)} s, ${res.impulses.length} impulses`);
+    const what = res.error ? `${res.error.kind}: ${String(res.error.message).slice(0, 80)}` : `${res.duration.toFixed(6)} s, ${res.impulses.length} impulses`;
+    console.log(`${c.name} | ${name} | median ${s[s.length >> 1].toFixed(1)} ms, min ${s[0].toFixed(1)} ms | ${what}`);
   });
 }

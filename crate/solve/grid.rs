@@ -14,7 +14,9 @@
 //! When there are vibration limits the program minimises the common level s with
 //! V(ωⱼ, ζⱼ) ≤ s·Vtolⱼ (so s ≤ 1 means feasible, and the solution is unique and sparse at the
 //! shortest feasible duration); otherwise it minimises the centroid Σ Aₖtₖ (an LP whose optimal
-//! vertex uses few grid points).
+//! vertex uses few grid points; where the optimum is not unique the interior-point solver
+//! returns the centre of the optimal face instead, and a failed polish is retried from a vertex:
+//! [`super::vertex`]).
 
 use super::{NormalizedLimit, NormalizedProblem};
 use crate::error::{Error, Result};
@@ -40,6 +42,19 @@ pub(crate) struct Outcome {
     pub amplitudes: Vec<f64>,
     /// The smallest common level s with V ≤ s·Vtol at every limit (0 without limits).
     pub level: f64,
+}
+
+/// The rows of the program's equalities on `times` (Σ A = 1, then the zero-vibration moments,
+/// each part scaled to a largest coefficient of 1), dense: the matrix of the LP that
+/// [`super::vertex::to_vertex`] reduces a solution of.
+pub(crate) fn equality_rows(problem: &NormalizedProblem, times: &[f64]) -> Vec<Vec<f64>> {
+    let mut program = Program::default();
+    program.zero_cone(problem, times);
+    let mut rows = vec![vec![0.0; times.len()]; program.row];
+    for ((&r, &c), &v) in program.rows.iter().zip(&program.cols).zip(&program.vals) {
+        rows[r][c] = v;
+    }
+    rows
 }
 
 /// Solves the program on `times` (sorted, first 0; the last is the shaper's end).

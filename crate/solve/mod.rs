@@ -32,6 +32,7 @@
 pub(crate) mod grid;
 pub(crate) mod polish;
 pub(crate) mod scan;
+pub(crate) mod vertex;
 
 use crate::error::{finite, Error, Result};
 use crate::shaper::{Impulse, Shaper};
@@ -536,7 +537,7 @@ fn shortest(norm: NormalizedProblem) -> Result<Design> {
     }
     let mut programs = 0;
     for round in 1..=MAX_EXCHANGE_ROUNDS {
-        let grid = shortest_on_grid(&norm, &samples, None, &mut programs)?;
+        let mut grid = shortest_on_grid(&norm, &samples, None, &mut programs)?;
         // Neighbouring grid impulses that add up beyond the amplitude bounds mean the grid is
         // emulating impulses the bounds forbid (binding bounds, e.g. negative shapers): no
         // few-impulse structure to polish, and finer grids only emulate more closely.
@@ -547,7 +548,7 @@ fn shortest(norm: NormalizedProblem) -> Result<Design> {
         let polished = if beyond_bounds {
             None
         } else {
-            polish::polish(&norm, &grid)
+            polished_grid(&norm, &samples, &mut grid)
         };
         if polished.is_none() && round < MAX_EXCHANGE_ROUNDS {
             // The polish failed. If the grid solution itself exceeds a band between the samples,
@@ -624,7 +625,7 @@ fn refine(
         }
         let pattern = refine_pattern(&grid);
         grid = shortest_on_grid(norm, samples, Some((&pattern, grid.duration)), programs)?;
-        polished = polish::polish(norm, &grid);
+        polished = polished_grid(norm, samples, &mut grid);
     }
     Ok((grid, polished))
 }
@@ -737,6 +738,37 @@ fn shortest_on_grid(
     hi.solution.ok_or_else(|| Error::Infeasible {
         reason: infeasible_reason(norm),
     })
+}
+
+/// The polish of a grid solution; if it fails where the grid program is a plain LP — no
+/// vibration limits, amplitudes ≥ 0 with no upper bound that can bind (the `direct` family's
+/// default) — the solution is moved to a vertex of its face with no larger centroid
+/// ([`vertex::to_vertex`]: at most one impulse per equality) and polished again. The
+/// interior-point solver returns the centre of the optimal face, which is the vertex itself
+/// when the optimum is unique (every design that polished before is unchanged: this runs only
+/// after a failure); when it is not (six-mode `direct` ZVD), every grid point is positive —
+/// 818 impulses after the fallback natively, an error in wasm, where the fallback's program
+/// could not reproduce them (issue 24). The grid is left at the vertex for the refinement and
+/// the fallback that follow a second failure.
+#[cfg(feature = "solver")]
+fn polished_grid(
+    norm: &NormalizedProblem,
+    samples: &[NormalizedLimit],
+    grid: &mut GridSolution,
+) -> Option<Vec<Impulse>> {
+    let polished = polish::polish(norm, grid);
+    let n = grid.times.len();
+    let lp = samples.is_empty()
+        && norm.amplitude_min == 0.0
+        && norm.amplitude_max >= norm.amplitude_reach(n);
+    if polished.is_some() || !lp || n == 0 {
+        return polished;
+    }
+    let rows = grid::equality_rows(norm, &grid.times);
+    let t_end = grid.duration.max(f64::MIN_POSITIVE);
+    let centroid: Vec<f64> = grid.times.iter().map(|t| t / t_end).collect();
+    vertex::to_vertex(&rows, &centroid, &mut grid.amplitudes);
+    polish::polish(norm, grid)
 }
 
 /// The grid programs of one [`shortest_on_grid`] search, counted.
