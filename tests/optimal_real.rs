@@ -44,7 +44,8 @@ fn load(path: &std::path::Path) -> (CalibrationData, Vec<MeasuredMode>) {
 }
 
 /// The smallest last amplitudes of the R = 0 floor: `FLOOR_MINIMA` (comma-separated), by
-/// default the optimiser's 2 % rule and none.
+/// default the optimiser's 2 % rule and none. The floors need the solver.
+#[cfg(feature = "solver")]
 fn floor_minima() -> Vec<f64> {
     std::env::var("FLOOR_MINIMA").map_or_else(
         |_| vec![input_shaping::measure::optimal::MIN_CUSTOM_AMPLITUDE, 0.0],
