@@ -119,6 +119,17 @@ enum Con {
     Stationary { point: usize, coord: usize },
 }
 
+/// What a column of [`Setup::jacobian`] moves.
+#[derive(Clone, Copy)]
+enum Moved {
+    /// Impulse i's time (`true`; never the last one's) or amplitude.
+    Impulse(usize, bool),
+    /// A free coordinate of active point p.
+    Point(usize),
+    /// Anything else (the last time): every sum.
+    All,
+}
+
 /// The moment sums of [`Setup::sums`]: per zero, M₀ … M_d; per active point, its (ω, ζ) and
 /// M₀ (and M₁).
 #[derive(Debug, Clone)]
@@ -196,14 +207,28 @@ impl Setup<'_> {
         let points = self
             .points
             .iter()
-            .map(|pt| {
-                let (w, z) = (self.coord(pt.omega, y), self.coord(pt.zeta, y));
-                let stationary =
-                    matches!(pt.omega, Coord::Free(_)) || matches!(pt.zeta, Coord::Free(_));
-                (w, z, vibration_moments(imps, w, z, u32::from(stationary)))
-            })
+            .map(|pt| self.point_sums(pt, imps, y))
             .collect();
         Sums { zeros, points }
+    }
+
+    /// One active point's entry of [`Sums`]: its (ω, ζ) at `y` and M₀ (with M₁ where a
+    /// stationarity row needs it).
+    fn point_sums(&self, pt: &Point, imps: &[Impulse], y: &[f64]) -> (f64, f64, Vec<[f64; 2]>) {
+        let (w, z) = (self.coord(pt.omega, y), self.coord(pt.zeta, y));
+        let stationary = matches!(pt.omega, Coord::Free(_)) || matches!(pt.zeta, Coord::Free(_));
+        (w, z, vibration_moments(imps, w, z, u32::from(stationary)))
+    }
+
+    /// c(y) where `y` differs from the iterate of `base` (its sums) only in a free coordinate
+    /// of active point `point`: that point's sums computed again, every other entry taken
+    /// from `base` — the same numbers as [`Setup::residuals`], whose other entries depend on
+    /// neither the point's ω nor its ζ (each free coordinate belongs to one point).
+    fn residuals_at_point(&self, base: &Sums, y: &[f64], point: usize) -> Vec<f64> {
+        let imps = self.impulses(y);
+        let mut sums = base.clone();
+        sums.points[point] = self.point_sums(&self.points[point], &imps, y);
+        self.rows(&sums, &imps)
     }
 
     /// c from its moments (and the impulses, for Σ A, the bounds and t_n).
@@ -238,36 +263,47 @@ impl Setup<'_> {
     /// time of one impulse but the last, changes one term of each moment sum: its residuals
     /// keep the other impulses' factors of the iterate ([`Setup::residuals_moved`], the same
     /// numbers as [`Setup::residuals`]; a unit test compares them on every column of every
-    /// Jacobian a design takes). The last time (the vibration's reference instant) and a free
-    /// ω or ζ move every term.
+    /// Jacobian a design takes). A free ω or ζ of an active point moves that point's sums
+    /// alone: its columns keep every other sum of the iterate ([`Setup::residuals_at_point`],
+    /// compared the same way). The last time (the vibration's reference instant) moves every
+    /// term.
     fn jacobian(&self, y: &[f64]) -> DMatrix<f64> {
         let m = self.m;
-        let base = self.factors(&self.impulses(y), y);
+        let imps = self.impulses(y);
+        let base = self.factors(&imps, y);
+        let base_sums = self.sums(&imps, y);
         let mut j = DMatrix::zeros(self.cons.len(), self.n);
         let mut yp = y.to_vec();
         for col in 0..self.n {
             let moved = if col + 2 < m {
-                Some((col + 1, true))
+                Moved::Impulse(col + 1, true)
             } else if (m - 1..2 * m - 1).contains(&col) {
-                Some((col + 1 - m, false))
+                Moved::Impulse(col + 1 - m, false)
+            } else if let Some(p) = self
+                .points
+                .iter()
+                .position(|p| p.omega == Coord::Free(col) || p.zeta == Coord::Free(col))
+            {
+                Moved::Point(p)
             } else {
-                None
+                Moved::All
             };
-            let residuals = |yy: &[f64]| match moved {
-                Some((i, time)) => {
-                    let r = self.residuals_moved(&base, yy, i, time);
-                    #[cfg(test)]
-                    assert_eq!(
-                        r.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
-                        self.residuals(yy)
-                            .iter()
-                            .map(|v| v.to_bits())
-                            .collect::<Vec<_>>(),
-                        "column {col}: the kept factors give the residuals to the bit"
-                    );
-                    r
-                }
-                None => self.residuals(yy),
+            let residuals = |yy: &[f64]| {
+                let r = match moved {
+                    Moved::Impulse(i, time) => self.residuals_moved(&base, yy, i, time),
+                    Moved::Point(p) => self.residuals_at_point(&base_sums, yy, p),
+                    Moved::All => return self.residuals(yy),
+                };
+                #[cfg(test)]
+                assert_eq!(
+                    r.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    self.residuals(yy)
+                        .iter()
+                        .map(|v| v.to_bits())
+                        .collect::<Vec<_>>(),
+                    "column {col}: the kept factors or sums give the residuals to the bit"
+                );
+                r
             };
             let h = JACOBIAN_STEP * y[col].abs().max(1.0);
             yp[col] = y[col] + h;
@@ -1427,10 +1463,12 @@ mod tests {
         }
     }
     /// Every Jacobian column that moves one impulse alone is computed from the iterate's kept
-    /// factors; under `cfg(test)` each such column is also computed in full and must equal it
+    /// factors, every column that moves an active point's free ω or ζ from the iterate's other
+    /// sums; under `cfg(test)` each such column is also computed in full and must equal it
     /// to the bit (the assertion in [`Setup::jacobian`]). These problems take the polish through
     /// bands over one and three damped modes (the decay factors), negative amplitudes (bound
-    /// rows) and zero-vibration constraints with their moments (a `direct` ZVD over three).
+    /// rows), zero-vibration constraints with their moments (a `direct` ZVD over three) and a
+    /// damping range (free ζ).
     #[test]
     fn jacobian_columns_from_kept_factors_are_the_full_ones() {
         use crate::solve::{minimum_duration, Band, Problem, Tolerance, ZeroVibration};
@@ -1467,13 +1505,23 @@ mod tests {
             ),
             problem(Vec::new(), vec![band(1.0, 0.05, 0.25)], -0.2),
             problem(vec![zvd(1.2), zvd(3.4), zvd(7.9)], Vec::new(), 0.0),
+            // A damping range: active points with a free ζ as well as a free ω.
+            problem(
+                Vec::new(),
+                vec![Band {
+                    damping_from: 0.01,
+                    damping_to: 0.08,
+                    ..band(2.0, 0.0, 0.2)
+                }],
+                0.0,
+            ),
         ];
-        // The polish runs on all four (its Jacobians checked); with negative amplitudes it
+        // The polish runs on all five (its Jacobians checked); with negative amplitudes it
         // ends on the grid solution here.
         let polished: Vec<bool> = problems
             .iter()
             .map(|p| minimum_duration(p).unwrap().polished)
             .collect();
-        assert_eq!(polished, [true, true, false, true]);
+        assert_eq!(polished, [true, true, false, true, true]);
     }
 }
