@@ -3,8 +3,8 @@
 # then shrinks each wasm with npm's binaryen (Debian's wasm-opt 108 breaks it; see docs/building.md).
 #
 # Each wasm is built by the pinned nightly of scripts/nightly.sh, which compiles the standard
-# library with the crate (-Z build-std) at the module's opt-level ("z", or 2 for the page's
-# main thread and its measured-data worker; below) and LTO, with panic locations left out (-Z location-detail=none; panic
+# library with the crate (-Z build-std) at the module's opt-level (2 for every module since
+# 2026-12-07; build_module's default is "z"; below) and LTO, with panic locations left out (-Z location-detail=none; panic
 # messages stay, but for the main thread's module: below): same code, same results, ~24 KB less gzip (docs/page-performance.md, *Shipped size*). std's
 # `optimize_for_size` feature would save 7 KB more, but it formats floats (every tick label)
 # with Dragon4 only, not Grisu. Without that toolchain (setup could not install it), or with
