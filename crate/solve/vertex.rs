@@ -1,6 +1,6 @@
 //! From a feasible point of a linear program in standard form (A x = b, x ≥ 0, minimise c·x) to
-//! a basic feasible one — a vertex, with at most rank(A) nonzero entries — whose objective is no
-//! larger (Carathéodory's reduction, the "purification" step of interior-point LP codes:
+//! one with at most as many nonzero entries as A has rows — a vertex when the rows are
+//! independent, as the `direct` programs' are — whose objective is no larger (Carathéodory's reduction, the "purification" step of interior-point LP codes:
 //! Megiddo, *On finding primal- and dual-optimal bases*, ORSA J. Computing 3(1), 1991).
 //!
 //! The grid programs of the `direct` family are such LPs: the zero-vibration equalities and
@@ -72,8 +72,9 @@ fn null_vector(a: &[Vec<f64>], cols: &[usize]) -> Option<Vec<f64>> {
     (top.is_finite() && top > 0.0).then(|| z.iter().map(|v| v / top).collect())
 }
 
-/// Moves `x` (A x = b, x ≥ 0 up to rounding, `a` the rows of A) to a vertex of {A x = b, x ≥ 0}
-/// with c·x no larger: while more entries are positive than A has rows, a direction z in the
+/// Moves `x` (A x = b, x ≥ 0 up to rounding, `a` the rows of A) to a point of {A x = b, x ≥ 0}
+/// with at most as many positive entries as rows (a vertex if the rows are independent) and
+/// c·x no larger: while more entries are positive than A has rows, a direction z in the
 /// null space of (the first rows + 1 of) their columns, signed so that c·z ≤ 0, is followed
 /// until an entry reaches 0, which is dropped. Each step keeps A x = b (to rounding) and removes
 /// at least one entry, so it ends after at most (positive entries − rows) steps. Negative
