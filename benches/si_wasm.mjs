@@ -5,8 +5,9 @@
 //   bash scripts/build.sh --library          # this branch's pkg/input_shaping.js
 //   node benches/si_wasm.mjs OLD/input_shaping.js pkg/input_shaping.js
 //
-// ALL=1 adds the other rows (see below). Prints per build and case the median and minimum of RUNS (default 5) runs after one warm-up
-// (wall clock), and the design's duration and impulse count (which must agree).
+// ALL=1 adds the other rows (see below). Prints per build and case the median and
+// minimum of RUNS (default 5) runs after one warm-up (wall clock), and the design's duration
+// and impulse count (which must agree), or its error's kind and message.
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
 
