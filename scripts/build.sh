@@ -57,10 +57,11 @@ fi
 # 159 → 79 ms), opt-level 3 / `-O3` no faster, for 66.7 KB more gzip (255.0 → 321.7 KB).
 # The whole API's module (pkg/input_shaping) and the design worker's (designer) are built for
 # speed as well, opt-level 2 and `wasm-opt -O2`: neither is part of the first load, and the
-# solved families' designs run in them (issue 24 item 1: `si` over three modes in Node,
-# I 0.3 216 -> 104 ms, I 0.7 1277 -> 746 ms, the same designs; opt-level 3 / `-O3` and
-# +simd128 no faster), for about 165 KB more gzip in the library's wasm (523.8 -> 689.3 KB)
-# (docs/benchmarks.md, *Solved families*, 2026-12-07).
+# solved families' designs run in them (issue 24 item 1: `si` over three modes in Node, with
+# `vibration::magnitude`, I 0.3 219 -> 95 ms, I 0.7 1328 -> 736 ms, the same designs;
+# opt-level 3 / `-O3` and +simd128 no faster), for 165 KB more gzip in the library's wasm
+# (521.5 -> 686.5 KB) and 41 KB in the designer's (165.7 -> 206.7 KB) (docs/benchmarks.md,
+# *Solved families*, 2026-12-07).
 # The page's main-thread module builds its dependencies that no frame spends time in (std,
 # serde, serde-wasm-bindgen, nalgebra, ...) at "s" while the crate and the drawing path
 # (plotters, its canvas backend, web-sys, js-sys, wasm-bindgen) stay at 2 (DEPS_OPT below):
