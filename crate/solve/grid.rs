@@ -194,7 +194,7 @@ impl Program {
         n_amp: usize,
         increment_max: Option<f64>,
     ) {
-        let upper = problem.amplitude_max < problem.amplitude_reach(n_amp);
+        let upper = problem.upper_bound_binds(n_amp);
         for k in 0..n_amp {
             self.push(k, -1.0); // A_k − A_min ≥ 0
             self.end_row(-problem.amplitude_min);

@@ -337,6 +337,12 @@ impl NormalizedProblem {
         1.0 - n.saturating_sub(1) as f64 * self.amplitude_min.min(0.0)
     }
 
+    /// Whether amplitudeMax can bind on `n` amplitudes (is below [`Self::amplitude_reach`]):
+    /// only then is it a row of the grid program.
+    pub(crate) fn upper_bound_binds(&self, n: usize) -> bool {
+        self.amplitude_max < self.amplitude_reach(n)
+    }
+
     /// The scale of the amplitude bounds for `n` amplitudes, for tolerances and for telling an
     /// amplitude near a bound: amplitudeMax − amplitudeMin with amplitudeMax taken at most
     /// [`Self::amplitude_reach`] (a larger bound, up to `amplitudeMax: 1e12`, binds nothing and
@@ -758,9 +764,7 @@ fn polished_grid(
 ) -> Option<Vec<Impulse>> {
     let polished = polish::polish(norm, grid);
     let n = grid.times.len();
-    let lp = samples.is_empty()
-        && norm.amplitude_min == 0.0
-        && norm.amplitude_max >= norm.amplitude_reach(n);
+    let lp = samples.is_empty() && norm.amplitude_min == 0.0 && !norm.upper_bound_binds(n);
     if polished.is_some() || !lp || n == 0 {
         return polished;
     }
