@@ -58,7 +58,7 @@ struct ResultOut<'a> {
     centroid_delay: Option<f64>,
     klipper: &'a Option<crate::smoothing::KlipperFigures>,
     /// Metrics of the shaped move on the simulated (mismatched) plant.
-    simulation: Option<&'a Metrics>,
+    simulation: &'a Metrics,
     sampled: &'a Option<analysis::SampledFigures>,
 }
 
@@ -142,7 +142,7 @@ fn frame(state: JsValue, canvases: &JsValue) -> Result<JsValue, Error> {
             residual_at_modes: &r.residual_at_modes,
             centroid_delay: r.centroid_delay,
             klipper: &r.klipper,
-            simulation: Some(m),
+            simulation: m,
             sampled: &r.sampled,
         })
         .collect();
