@@ -49,13 +49,24 @@ const MAX_NULL_STEP: f64 = 0.05;
 /// Largest the null-space step's cap grows to after full steps (the reference path keeps
 /// [`MAX_NULL_STEP`]).
 const LARGEST_NULL_STEP: f64 = 0.8;
+/// Chord iterations that pull a trial point back onto c = 0, at most. Each costs one
+/// evaluation of c; the reduced Hessian of the step they test costs 1 + nz² (issue 24: with 4,
+/// as before, a 17-impulse polish over three bands took its null-space steps at α = 1/64 for
+/// 30 iterations — a longer step was restorable, not in 4 chords to the 1e-13 tolerance).
+const MAX_CHORD_ITERATIONS: usize = 12;
+/// … while each leaves at most this fraction of the previous largest residual (a chord that
+/// does not contract will not restore the point: stop early).
+const CHORD_CONTRACTION: f64 = 0.5;
+/// The reference path's fixed chord count.
+const REFERENCE_CHORD_ITERATIONS: usize = 4;
 /// Finite-difference step for the Jacobian.
 const JACOBIAN_STEP: f64 = 1e-7;
 /// Finite-difference step for the reduced Hessian.
 const HESSIAN_STEP: f64 = 1e-4;
 
 /// The polish as it was before issue 24's speed work (the four-point Hessian stencil, a fixed
-/// null-step cap), for benchmarks that compare the two in one run.
+/// null-step cap, four chord iterations per trial point), for benchmarks that compare the two
+/// in one run.
 static REFERENCE_POLISH: AtomicBool = AtomicBool::new(false);
 
 /// Whether the reference (previous) polish is selected.
@@ -805,18 +816,26 @@ fn optimality_step(
 ) -> Option<(Vec<f64>, f64)> {
     let di = setup.duration_index();
     // A trial point: the Gauss–Newton step plus α times the null-space step, pulled back
-    // onto c = 0 with the current Jacobian (chord iterations).
+    // onto c = 0 with the current Jacobian (chord iterations, while they contract).
+    let (chords, contraction) = if reference_polish() {
+        (REFERENCE_CHORD_ITERATIONS, f64::INFINITY)
+    } else {
+        (MAX_CHORD_ITERATIONS, CHORD_CONTRACTION)
+    };
     let trial_at = |alpha: f64| -> Option<Vec<f64>> {
         let dy = dy_range + null_step * alpha;
         let mut trial = step_to(y, &dy, 1.0);
-        for _ in 0..4 {
+        let mut last = f64::INFINITY;
+        for _ in 0..chords {
             if !setup.valid(&trial) {
                 return None;
             }
             let ct = DVector::from_vec(setup.residuals(&trial));
-            if ct.amax() <= RESIDUAL_TOLERANCE {
+            let now = ct.amax();
+            if now <= RESIDUAL_TOLERANCE || now > contraction * last {
                 break;
             }
+            last = now;
             let corr = lin.restore(&ct);
             for (t, d) in trial.iter_mut().zip(corr.iter()) {
                 *t += d;
