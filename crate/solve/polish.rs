@@ -866,10 +866,22 @@ fn optimality_step(
 }
 
 /// The state of the active-set loop: impulses and active points.
+#[derive(Clone)]
 struct Active {
     impulses: Vec<Impulse>,
     points: Vec<PointSpec>,
     bounds: Vec<(usize, bool)>,
+}
+
+impl Active {
+    /// The same Newton problem as `other`: the same impulses and bounds, and the same active
+    /// points in any order (their order only orders the equations).
+    fn same_structure(&self, other: &Active) -> bool {
+        self.impulses == other.impulses
+            && self.bounds == other.bounds
+            && self.points.len() == other.points.len()
+            && self.points.iter().all(|p| other.points.contains(p))
+    }
 }
 
 /// An active point before it is given unknowns.
@@ -1001,6 +1013,8 @@ fn freedom(norm: &NormalizedProblem, active: &Active) -> i64 {
 pub(crate) fn polish(norm: &NormalizedProblem, grid: &GridSolution) -> Option<Vec<Impulse>> {
     let found = clusters(grid);
     let raw = grid.impulses();
+    // Ranked on the grid solution, which every split shares: scanned once.
+    let candidates = candidates(norm, &raw);
     let mut wide: Vec<usize> = (0..found.len())
         .filter(|&i| found[i].spacing > 0.0 && found[i].spread > 0.55 * found[i].spacing)
         .collect();
@@ -1034,7 +1048,7 @@ pub(crate) fn polish(norm: &NormalizedProblem, grid: &GridSolution) -> Option<Ve
         for imp in &mut start {
             imp.time = (imp.time - t0).max(0.0);
         }
-        if let Some(result) = polish_from(norm, &raw, start) {
+        if let Some(result) = polish_from(norm, &candidates, start) {
             // Every grid solution is itself a feasible shaper, so with exact (sampled)
             // constraints a longer result is a worse local optimum: reject it. (With bands the
             // grid only saw samples and may be shorter than any shaper meeting the whole band.)
@@ -1047,19 +1061,24 @@ pub(crate) fn polish(norm: &NormalizedProblem, grid: &GridSolution) -> Option<Ve
     None
 }
 
-/// The active-set loop from one starting structure.
+/// The active-set loop from one starting structure, with the candidate points of
+/// [`candidates`].
 fn polish_from(
     norm: &NormalizedProblem,
-    raw: &[Impulse],
+    candidates: &[PointSpec],
     start: Vec<Impulse>,
 ) -> Option<Vec<Impulse>> {
-    let candidates = candidates(norm, raw);
     let top = candidates.first().map_or(0.0, |c| c.grid_ratio);
-    let mut active = initial_active(norm, start, &candidates, top);
+    let mut active = initial_active(norm, start, candidates, top);
     let mut retry = Retry {
         dropped_from: None,
         drops: 0,
     };
+    // Structures with no exact solution. A drop frees room, and the next restructure refills
+    // it, often with the point just dropped: the structure that already failed, solved again
+    // the same way (issue 24: 4 of the 9 Newton solves of a three-mode si polish's first
+    // start). Such a structure counts as a round and fails at once.
+    let mut failed: Vec<Active> = Vec::new();
     for _ in 0..MAX_ACTIVE_SET_ROUNDS {
         // (More equations than unknowns is allowed: degenerate but consistent systems, e.g.
         // a single-mode ZVD that also cancels a mode at an odd multiple of its frequency, are
@@ -1067,9 +1086,17 @@ fn polish_from(
         if active.impulses.len() < 2 {
             return None;
         }
-        let (setup, y0) = build(norm, &active);
-        let Some(solved) = sqp(&setup, y0) else {
-            if retry.restructure(norm, &mut active, &candidates, top) {
+        let solved = if failed.iter().any(|f| f.same_structure(&active)) {
+            None
+        } else {
+            let (setup, y0) = build(norm, &active);
+            sqp(&setup, y0).map(|solved| (setup, solved))
+        };
+        let Some((setup, solved)) = solved else {
+            if !failed.iter().any(|f| f.same_structure(&active)) {
+                failed.push(active.clone());
+            }
+            if retry.restructure(norm, &mut active, candidates, top) {
                 continue;
             }
             return None;
