@@ -34,6 +34,11 @@ pub(crate) const SEARCH_TOLERANCE: f64 = 1e-7;
 /// the amplitude bounds and the level to near rounding, so that renormalising to Σ A = 1
 /// moves V by far less than the result check's tolerance.
 pub(crate) const EXACT_TOLERANCE: f64 = 1e-10;
+/// The KKT solves' iterative refinement stops at this fraction of a search program's
+/// tolerance …
+const REFINEMENT_FACTOR: f64 = 0.1;
+/// … and at clarabel's default (relative 1e-13) for an exact one.
+const EXACT_REFINEMENT: f64 = 1e-13;
 
 /// What the program found on one set of times.
 #[derive(Debug, Clone)]
@@ -247,6 +252,11 @@ impl Program {
     ) -> Result<Option<Vec<f64>>> {
         let p = CscMatrix::zeros((n, n));
         let a = by_columns(self.row, n, &self.rows, &self.cols, &self.vals);
+        let refinement = if tolerance > EXACT_TOLERANCE {
+            REFINEMENT_FACTOR * tolerance
+        } else {
+            EXACT_REFINEMENT
+        };
         let settings = DefaultSettings {
             verbose: false,
             max_iter: MAX_SOLVER_ITERATIONS,
@@ -255,6 +265,8 @@ impl Program {
             tol_gap_rel: tolerance,
             tol_feas: tolerance,
             iterative_refinement_max_iter: 3,
+            iterative_refinement_reltol: refinement,
+            iterative_refinement_abstol: refinement,
             ..DefaultSettings::default()
         };
         let Ok(mut solver) = DefaultSolver::new(&p, q, &a, &self.b, cones, settings) else {
