@@ -122,8 +122,25 @@ pub(crate) fn vibration_moments(
 #[inline]
 pub(crate) fn moment_factor(time: f64, t_n: f64, omega: f64, zeta: f64, damped: f64) -> [f64; 3] {
     let decay = (-(zeta * omega) * (t_n - time)).exp();
-    let (sin, cos) = (omega * damped * time).sin_cos();
+    let (sin, cos) = sin_cos(omega * damped * time);
     [decay, sin, cos]
+}
+
+/// (sin x, cos x). In wasm, `f64::sin_cos` is libm's `sin` and `cos` one after the other, each
+/// reducing x modulo π/2 itself; libm's `sincos` reduces once and runs the same kernels — the
+/// same bits (test `sincos_is_sin_and_cos`, run in wasm) for about 3 % of a solved design's
+/// time (issue 24). Only where the solver is built: the page's size-tuned module keeps the
+/// two calls it already carries. Natively `sin_cos` is the platform's `sincos` already.
+#[inline]
+pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
+    #[cfg(all(target_arch = "wasm32", feature = "solver"))]
+    {
+        libm::sincos(x)
+    }
+    #[cfg(not(all(target_arch = "wasm32", feature = "solver")))]
+    {
+        x.sin_cos()
+    }
 }
 
 /// The moments M₀ … M_`k_max` of [`vibration_moments`] from each impulse's factors
@@ -1268,6 +1285,41 @@ mod tests {
         assert!(magnitude(f64::NAN, 1.0).is_nan() && magnitude(1.0, f64::NAN).is_nan());
         assert_eq!(magnitude(f64::INFINITY, f64::NAN), f64::INFINITY);
         assert_eq!(magnitude(-f64::INFINITY, 1.0), f64::INFINITY);
+    }
+
+    /// [`super::sin_cos`] gives the bits of `sin` and `cos` called one by one (in wasm it is
+    /// libm's `sincos`, and std's `sin` and `cos` are libm's too): over arguments from 10⁻³⁰⁰ to
+    /// 10³⁰⁰ of both signs — each octant, the kernels' small-argument paths, the large
+    /// arguments' Payne–Hanek reduction — and ±0, ±∞, NaN. Run natively and in wasm.
+    #[wasm_bindgen_test::wasm_bindgen_test(unsupported = test)]
+    fn sincos_is_sin_and_cos() {
+        let bits = |(a, b): (f64, f64)| (a.to_bits(), b.to_bits());
+        let mut u = 0.123_f64;
+        let mut args = vec![
+            0.0,
+            -0.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            1e-310,
+        ];
+        for _ in 0..100_000 {
+            u = (u * 3.7 + 0.31).fract();
+            let x = (u - 0.5) * 10f64.powi((u * 1e4) as i32 % 600 - 300);
+            args.extend([
+                x,
+                x.abs().fract() * 12.0,
+                (u * 8.0).floor() * std::f64::consts::FRAC_PI_4,
+            ]);
+        }
+        for x in args {
+            let (s, c) = super::sin_cos(x);
+            if x.is_finite() {
+                assert_eq!(bits((s, c)), bits((x.sin(), x.cos())), "{x:e}");
+            } else {
+                assert!(s.is_nan() && c.is_nan(), "{x}");
+            }
+        }
     }
 
     /// Runs `refine_crossing` on `g` over (`inside`, `outside`) and returns the crossing and
