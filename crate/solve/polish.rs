@@ -1086,14 +1086,15 @@ fn polish_from(
         if active.impulses.len() < 2 {
             return None;
         }
-        let solved = if failed.iter().any(|f| f.same_structure(&active)) {
+        let known_failure = failed.iter().any(|f| f.same_structure(&active));
+        let solved = if known_failure {
             None
         } else {
             let (setup, y0) = build(norm, &active);
             sqp(&setup, y0).map(|solved| (setup, solved))
         };
         let Some((setup, solved)) = solved else {
-            if !failed.iter().any(|f| f.same_structure(&active)) {
+            if !known_failure {
                 failed.push(active.clone());
             }
             if retry.restructure(norm, &mut active, candidates, top) {
