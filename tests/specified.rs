@@ -203,6 +203,35 @@ fn longer_for_wider_bands() {
     }
 }
 
+/// `si` over modes at `freqs` (each at damping `zeta`), insensitivity `i`, Vtol `vtol`.
+fn si_over(freqs: &[f64], zeta: f64, i: f64, vtol: f64) -> Shaper {
+    let modes = freqs
+        .iter()
+        .map(|&frequency_hz| ModeSpec {
+            frequency_hz,
+            damping: zeta,
+        })
+        .collect();
+    let spec = SiSpec {
+        vtol,
+        insensitivity: Some(i),
+        ..SiSpec::default()
+    };
+    design(&spec.request(modes)).unwrap()
+}
+
+/// A positive shaper with Σ A = 1 and V ≤ `vtol` (by superposition, 1001 points) over every
+/// band f(1 ± i/2) of `freqs` at damping `zeta`.
+fn assert_holds_on_bands(s: &Shaper, freqs: &[f64], zeta: f64, i: f64, vtol: f64) {
+    close(s.amplitude_sum(), 1.0, 1e-12, "Σ A");
+    assert!(s.impulses().iter().all(|p| p.amplitude > 0.0));
+    for &f in freqs {
+        let (lo, hi) = (f * (1.0 - i / 2.0), f * (1.0 + i / 2.0));
+        let worst = max_v(s, lo, hi, zeta, 1001);
+        assert!(worst <= vtol * (1.0 + 1e-9), "V = {worst} on {lo}…{hi} Hz");
+    }
+}
+
 /// Four modes (1.2 / 3.4 / 7.9 / 13 Hz, ζ 0.02), each over f(1 ± 0.15) at Vtol 5 %: the polish
 /// converges to a few impulses. Until its trial points were pulled back onto the constraints
 /// by chords while they contract (12 at most) rather than by 4, every null-space step it
@@ -211,29 +240,10 @@ fn longer_for_wider_bands() {
 /// grid over every band, Σ A = 1, positive amplitudes, and no longer than that fallback.
 #[wasm_bindgen_test(unsupported = test)]
 fn four_mode_si_polishes_to_a_few_impulses() {
-    let (vtol, i) = (0.05, 0.3);
     let freqs = [1.2, 3.4, 7.9, 13.0];
-    let modes = freqs
-        .iter()
-        .map(|&frequency_hz| ModeSpec {
-            frequency_hz,
-            damping: 0.02,
-        })
-        .collect();
-    let spec = SiSpec {
-        vtol,
-        insensitivity: Some(i),
-        ..SiSpec::default()
-    };
-    let s = design(&spec.request(modes)).unwrap();
+    let s = si_over(&freqs, 0.02, 0.3, 0.05);
     assert!(s.len() <= 20, "{} impulses", s.len());
-    close(s.amplitude_sum(), 1.0, 1e-12, "Σ A");
-    assert!(s.impulses().iter().all(|p| p.amplitude > 0.0));
-    for &f in &freqs {
-        let (lo, hi) = (f * (1.0 - i / 2.0), f * (1.0 + i / 2.0));
-        let worst = max_v(&s, lo, hi, 0.02, 1001);
-        assert!(worst <= vtol * (1.0 + 1e-9), "V = {worst} on {lo}…{hi} Hz");
-    }
+    assert_holds_on_bands(&s, &freqs, 0.02, 0.3, 0.05);
     assert!(s.duration() <= 0.949_509_329_311, "{} s", s.duration());
 }
 
@@ -245,34 +255,15 @@ fn four_mode_si_polishes_to_a_few_impulses() {
 /// independently: V by superposition over every band, Σ A = 1, positive amplitudes.
 #[wasm_bindgen_test(unsupported = test)]
 fn the_shortest_polished_start_is_kept() {
-    let (vtol, i) = (0.05, 0.5);
     let freqs = [1.0, 3.0, 7.0];
-    let modes = freqs
-        .iter()
-        .map(|&frequency_hz| ModeSpec {
-            frequency_hz,
-            damping: 0.02,
-        })
-        .collect();
-    let spec = SiSpec {
-        vtol,
-        insensitivity: Some(i),
-        ..SiSpec::default()
-    };
-    let s = design(&spec.request(modes)).unwrap();
+    let s = si_over(&freqs, 0.02, 0.5, 0.05);
     assert!(
         s.duration() <= 1.347_056_83,
         "{} s, {} impulses",
         s.duration(),
         s.len()
     );
-    close(s.amplitude_sum(), 1.0, 1e-12, "Σ A");
-    assert!(s.impulses().iter().all(|p| p.amplitude > 0.0));
-    for &f in &freqs {
-        let (lo, hi) = (f * (1.0 - i / 2.0), f * (1.0 + i / 2.0));
-        let worst = max_v(&s, lo, hi, 0.02, 1001);
-        assert!(worst <= vtol * (1.0 + 1e-9), "V = {worst} on {lo}…{hi} Hz");
-    }
+    assert_holds_on_bands(&s, &freqs, 0.02, 0.5, 0.05);
 }
 
 /// Singhose 2009 Fig. 10: robust over 0.7 … 1.3 Hz *and* ζ ∈ [0, 0.2]. V ≤ 5 % on a dense
@@ -675,19 +666,7 @@ fn si_spec_from_json() {
 fn four_modes_amplitudes_sum_to_one() {
     let (vtol, i) = (0.05, 0.9);
     let freqs = [1.0, 1.1, 3.0, 10.0];
-    let spec = SiSpec {
-        vtol,
-        insensitivity: Some(i),
-        ..SiSpec::default()
-    };
-    let modes: Vec<ModeSpec> = freqs
-        .iter()
-        .map(|&frequency_hz| ModeSpec {
-            frequency_hz,
-            damping: 0.0,
-        })
-        .collect();
-    let s = design(&spec.request(modes)).expect("a shaper");
+    let s = si_over(&freqs, 0.0, i, vtol);
     assert!(s.len() <= 40, "{} impulses: not polished", s.len());
     let sum: f64 = s.impulses().iter().map(|p| p.amplitude).sum();
     assert!((sum - 1.0).abs() <= 1e-12, "Σ A = {sum}");
