@@ -69,7 +69,7 @@ fn bench(c: &mut Criterion) {
 /// The three-mode designs take 0.1–1 s each: ten samples. Each is timed twice in the same run:
 /// with the current polish (`i0.3`) and with the polish before issue 24's speed work
 /// (`i0.3_reference`: the four-point Hessian stencil, a fixed null-step cap, four chord
-/// iterations per trial point), selected by
+/// iterations per trial point, the first split start that converges), selected by
 /// `input_shaping::solve::set_reference_polish`.
 #[cfg(not(target_arch = "wasm32"))]
 fn bench_three_modes(c: &mut Criterion) {
