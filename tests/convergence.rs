@@ -61,7 +61,11 @@ impl Grid {
         match result {
             Ok(shaper) => match check_valid(&shaper).and_then(|_| check(&shaper)) {
                 Ok(()) => {
-                    eprintln!("  [{seconds:6.2} s] {what}: ok");
+                    eprintln!(
+                        "  [{seconds:6.2} s] {what}: ok, {} impulses, {:.9} s",
+                        shaper.impulses().len(),
+                        shaper.duration()
+                    );
                     tally.ok += 1
                 }
                 Err(why) => {
