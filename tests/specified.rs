@@ -266,6 +266,24 @@ fn the_shortest_polished_start_is_kept() {
     assert_holds_on_bands(&s, &freqs, 0.02, 0.5, 0.05);
 }
 
+/// One mode at 1 Hz, ζ 0.1, over f(1 ± 0.55) at Vtol 2 % (a point of the convergence grid):
+/// the grid solution's unused points are small, not 0, and no start from its clusters counted
+/// from 1e-6 of the largest amplitude polished: the design fell back to the grid, 101
+/// impulses, 2.609761976 s (natively, 2026-12-07). The clusters with that noise taken for zero
+/// polish it to 7 impulses (issue 24). Checked independently: V by superposition over the
+/// band, Σ A = 1, positive amplitudes, and no longer than that fallback.
+#[wasm_bindgen_test(unsupported = test)]
+fn a_grid_solution_with_noise_between_impulses_polishes() {
+    let s = si_over(&[1.0], 0.1, 1.1, 0.02);
+    assert!(s.len() <= 10, "{} impulses", s.len());
+    assert_holds_on_bands(&s, &[1.0], 0.1, 1.1, 0.02);
+    assert!(
+        s.duration() <= 2.609_761_976 * (1.0 + 1e-9),
+        "{} s",
+        s.duration()
+    );
+}
+
 /// Singhose 2009 Fig. 10: robust over 0.7 … 1.3 Hz *and* ζ ∈ [0, 0.2]. V ≤ 5 % on a dense
 /// (f, ζ) grid, and the damping range costs duration over the same band at one damping.
 #[wasm_bindgen_test(unsupported = test)]

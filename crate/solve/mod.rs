@@ -57,6 +57,10 @@ const REFINE_FACTOR: f64 = 4.0;
 const MAX_PROGRAMS: usize = 60;
 /// Relative slack by which a grid solution must beat Vtol to count as feasible.
 const FEASIBILITY_MARGIN: f64 = 1e-6;
+/// A grid solution's noise level ([`zero_level`]) lies in a gap of at least this ratio …
+const ZERO_GAP: f64 = 10.0;
+/// … whose lower side is at most this fraction of the largest amplitude.
+const ZERO_CEILING: f64 = 1e-3;
 /// Relative excess over Vtol tolerated when checking a result (rounding).
 pub const CHECK_TOLERANCE: f64 = 1e-9;
 /// Largest zero-vibration moment (scaled by t_nᵏ) accepted as zero.
@@ -987,10 +991,44 @@ pub(crate) struct Cluster {
 /// grid points shows as two or three neighbours; a run is split where it dips to a local
 /// minimum below a tenth of its neighbours (two impulses close together).
 pub(crate) fn clusters(grid: &GridSolution) -> Vec<Cluster> {
+    let max = grid.amplitudes.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+    clusters_above(grid, 1e-6 * max)
+}
+
+/// [`clusters`] with every amplitude up to the solution's [`zero_level`] taken for zero: the
+/// polish's second start.
+pub(crate) fn clusters_above_noise(grid: &GridSolution) -> Vec<Cluster> {
+    clusters_above(grid, zero_level(&grid.amplitudes))
+}
+
+/// The magnitude up to which a grid amplitude is noise. An interior-point solution leaves
+/// unused grid points at small values, not at 0: at the search's tolerance up to ~5e-5 of the
+/// largest amplitude (issue 24), where [`clusters`] counts everything above 1e-6 of it, so a
+/// run of such values can join two impulses into one cluster. The level sits in the widest
+/// gap, by ratio and of at least [`ZERO_GAP`], between consecutive sorted magnitudes whose
+/// lower side is at most [`ZERO_CEILING`] of the largest (at the gap's geometric middle);
+/// 1e-6 of the largest when there is no such gap.
+fn zero_level(a: &[f64]) -> f64 {
+    let max = a.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+    let floor = 1e-6 * max;
+    let mut mags: Vec<f64> = a.iter().map(|x| x.abs()).filter(|&m| m > 0.0).collect();
+    crate::sort::sort_by(&mut mags, |x, y| y.total_cmp(x));
+    let mut best: Option<(f64, f64)> = None;
+    for w in mags.windows(2) {
+        let (hi, lo) = (w[0], w[1]);
+        let wider = best.is_none_or(|(ratio, _)| hi / lo > ratio);
+        if lo <= ZERO_CEILING * max && hi >= ZERO_GAP * lo && wider {
+            best = Some((hi / lo, (hi * lo).sqrt()));
+        }
+    }
+    best.map_or(floor, |(_, level)| level.max(floor))
+}
+
+/// [`clusters`] of the amplitudes above `threshold` in magnitude.
+fn clusters_above(grid: &GridSolution, threshold: f64) -> Vec<Cluster> {
     let a = &grid.amplitudes;
     let t = &grid.times;
     let max = a.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
-    let threshold = 1e-6 * max;
     let significant = |k: usize| a[k].abs() > threshold;
     let mut out: Vec<Cluster> = Vec::new();
     let mut k = 0;
@@ -1184,4 +1222,47 @@ fn fallback(
 /// V(ω, ζ) / Vtol on a normalized impulse sequence.
 pub(crate) fn ratio(impulses: &[Impulse], omega: f64, zeta: f64, vtol: f64) -> f64 {
     vibration_rad(impulses, omega, zeta) / vtol
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid_of(amplitudes: &[f64]) -> GridSolution {
+        let times: Vec<f64> = (0..amplitudes.len()).map(|k| 0.1 * k as f64).collect();
+        GridSolution {
+            duration: times[times.len() - 1],
+            times,
+            amplitudes: amplitudes.to_vec(),
+        }
+    }
+
+    /// Two impulses (0.5, and 0.3 + 0.2 on neighbouring points) with an interior-point
+    /// solution's noise between them (2e-5 … 4e-5): one cluster when everything above 1e-6 of
+    /// the largest counts, two once the noise is taken for zero. The noise level is the
+    /// geometric middle of the widest gap (0.2 over 4e-5; the gap 2e-5 over 1e-8 is narrower).
+    #[test]
+    fn noise_between_impulses_is_taken_for_zero() {
+        let a = [0.0, 0.5, 2e-5, 4e-5, 3e-5, 0.3, 0.2, 1e-8];
+        assert_eq!(clusters(&grid_of(&a)).len(), 1);
+        assert_eq!(zero_level(&a), (0.2_f64 * 4e-5).sqrt());
+        let two = clusters_above_noise(&grid_of(&a));
+        assert_eq!(two.len(), 2);
+        assert!((two[0].amplitude - 0.5).abs() < 1e-15 && (two[1].amplitude - 0.5).abs() < 1e-15);
+    }
+
+    /// A small impulse above the noise (4e-3 of the largest) stays a cluster of its own; with
+    /// no magnitude at or below 1e-3 of the largest there is no gap, and the level is 1e-6 of
+    /// the largest.
+    #[test]
+    fn small_impulses_stay_and_gapless_solutions_keep_the_floor() {
+        let a = [0.5, 1e-5, 0.002, 1e-5, 0.4];
+        assert_eq!(zero_level(&a), (0.002_f64 * 1e-5).sqrt());
+        let sums: Vec<f64> = clusters_above_noise(&grid_of(&a))
+            .iter()
+            .map(|c| c.amplitude)
+            .collect();
+        assert_eq!(sums, [0.5, 0.002, 0.4]);
+        assert_eq!(zero_level(&[0.5, 0.4, 0.3]), 1e-6 * 0.5);
+    }
 }
