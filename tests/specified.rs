@@ -730,3 +730,19 @@ fn a_vtol_profile_down_to_the_smallest_normal_number_ends() {
         "{result:?}"
     );
 }
+
+/// Issue 24's six-mode `si` (1.2 / 3.4 / 7.9 / 13 / 21 / 34 Hz, ζ 0.02, I 0.3, Vtol 5 %, the
+/// README's example): until 2026-12-07 every round's polish failed and, after about a minute
+/// natively, "the vibration bound could not be met everywhere on the band after 8 rounds". The
+/// polish's second start (clusters with the grid solution's noise taken for zero) gives a
+/// design: 29 impulses, 0.953096 s, in 43 s natively at release. Slow, so ignored; run by
+/// `npm run test:long`. Checked independently: V by superposition over every band, Σ A = 1,
+/// positive amplitudes, and a few impulses (a grid fallback would number hundreds).
+#[test]
+#[ignore = "long: about a minute; run with --ignored (npm run test:long)"]
+fn six_mode_si_is_designed() {
+    let freqs = [1.2, 3.4, 7.9, 13.0, 21.0, 34.0];
+    let s = si_over(&freqs, 0.02, 0.3, 0.05);
+    assert!(s.len() <= 40, "{} impulses", s.len());
+    assert_holds_on_bands(&s, &freqs, 0.02, 0.3, 0.05);
+}
