@@ -735,7 +735,8 @@ fn a_vtol_profile_down_to_the_smallest_normal_number_ends() {
 /// README's example): until 2026-12-07 every round's polish failed and, after about a minute
 /// natively, "the vibration bound could not be met everywhere on the band after 8 rounds". The
 /// polish's second start (clusters with the grid solution's noise taken for zero) gives a
-/// design: 29 impulses, 0.953096 s, in 43 s natively at release. Slow, so ignored; run by
+/// design in the last of the 8 exchange rounds (so one round less would lose it): 29
+/// impulses, 0.953096 s, in 43 s natively at release. Slow, so ignored; run by
 /// `npm run test:long`. Checked independently: V by superposition over every band, Σ A = 1,
 /// positive amplitudes, and a few impulses (a grid fallback would number hundreds).
 #[test]
