@@ -740,6 +740,7 @@ fn a_vtol_profile_down_to_the_smallest_normal_number_ends() {
 /// `npm run test:long`. Checked independently: V by superposition over every band, Σ A = 1,
 /// positive amplitudes, and a few impulses (a grid fallback would number hundreds).
 #[test]
+#[cfg(not(target_arch = "wasm32"))]
 #[ignore = "long: about a minute; run with --ignored (npm run test:long)"]
 fn six_mode_si_is_designed() {
     let freqs = [1.2, 3.4, 7.9, 13.0, 21.0, 34.0];

@@ -1002,9 +1002,10 @@ pub(crate) fn clusters_above_noise(grid: &GridSolution) -> Vec<Cluster> {
 }
 
 /// The magnitude up to which a grid amplitude is noise. An interior-point solution leaves
-/// unused grid points at small values, not at 0: at the search's tolerance up to ~5e-5 of the
-/// largest amplitude (issue 24), where [`clusters`] counts everything above 1e-6 of it, so a
-/// run of such values can join two impulses into one cluster. The level sits in the widest
+/// unused grid points at small values, not at 0 (issue 24: up to 5e-5 of the largest
+/// amplitude on a three-mode `si` grid solved to the search's tolerance), where [`clusters`]
+/// counts everything above 1e-6 of it, so a run of such values can join two impulses into one
+/// cluster. The level sits in the widest
 /// gap, by ratio and of at least [`ZERO_GAP`], between consecutive sorted magnitudes whose
 /// lower side is at most [`ZERO_CEILING`] of the largest (at the gap's geometric middle);
 /// 1e-6 of the largest when there is no such gap.
