@@ -1005,10 +1005,9 @@ pub(crate) fn clusters_above_noise(grid: &GridSolution) -> Vec<Cluster> {
 /// unused grid points at small values, not at 0 (issue 24: up to 5e-5 of the largest
 /// amplitude on a three-mode `si` grid solved to the search's tolerance), where [`clusters`]
 /// counts everything above 1e-6 of it, so a run of such values can join two impulses into one
-/// cluster. The level sits in the widest
-/// gap, by ratio and of at least [`ZERO_GAP`], between consecutive sorted magnitudes whose
-/// lower side is at most [`ZERO_CEILING`] of the largest (at the gap's geometric middle);
-/// 1e-6 of the largest when there is no such gap.
+/// cluster. The level sits in the widest gap, by ratio and of at least [`ZERO_GAP`], between
+/// consecutive sorted magnitudes whose lower side is at most [`ZERO_CEILING`] of the largest
+/// (at the gap's geometric middle); 1e-6 of the largest when there is no such gap.
 fn zero_level(a: &[f64]) -> f64 {
     let max = a.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
     let floor = 1e-6 * max;
