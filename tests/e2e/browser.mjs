@@ -24,10 +24,12 @@ export async function openBrowser() {
     url,
     /**
      * A fresh page at the playground (with `hash`, if given), with console errors and page
-     * errors collected in `problems` and the URL path of every request in `fetched`.
+     * errors collected in `problems` and the URL path of every request in `fetched`; `init`, a
+     * function run in the page before its own scripts (playwright's `addInitScript`).
      */
-    async page({ width = 1280, height = 800, hash = '' } = {}) {
+    async page({ width = 1280, height = 800, hash = '', init = null } = {}) {
       const page = await browser.newPage({ viewport: { width, height } });
+      if (init) await page.addInitScript(init);
       const problems = [];
       const fetched = [];
       page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
