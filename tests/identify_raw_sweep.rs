@@ -402,6 +402,23 @@ fn a_sweep_seen_over_part_of_the_record_is_found_and_its_mode_right() {
     all_found(&id, &[sim(64.47, 0.0146, 0.0)], "logunder");
 }
 
+/// A logarithmic sweep (23.6 → 118.6 Hz in 15.3 s at 1.6 kHz) through two low-pass modes,
+/// 36.6 Hz ζ 0.0143 and 59.4 Hz ζ 0.0139, whose response past the second falls under the
+/// sensor's noise (fixture `lognoise84`, sweep_chirps.py seed 8's c16). A bump of noise
+/// spikes at 84.2 Hz (half-power ζ 0.042, 9 dB over its surroundings) was fitted as a line,
+/// 83.68 Hz ζ 0.00087 ± 0.00065, and reported as a third mode until 2026-12-07: the two modes
+/// now, and nothing else.
+#[test]
+fn a_line_fitted_into_a_sweeps_noise_is_no_mode() {
+    let id = identified_file(include_str!("data/sweeps/raw_data_x_lognoise84.csv"));
+    assert!(id.sweep.is_some(), "no sweep");
+    all_found(
+        &id,
+        &[sim(36.618, 0.01431, 0.0), sim(59.378, 0.01392, -3.8)],
+        "lognoise84",
+    );
+}
+
 /// A sweep over a band that holds no mode (one mode at 8 Hz, swept 30–80 Hz at 2 Hz/s):
 /// the sweep is reported, no mode, and a note says why. Before, a sweep whose band showed no
 /// peak was dropped and the recording went the Welch path, which is not for sweeps, and

@@ -72,6 +72,10 @@ use spectrum_fit::spectrum_fit;
 use sweep::detect_sweep;
 pub use sweep::{Sweep, SweepLaw};
 
+/// How many times narrower than its peak's half-power width a fitted mode must be to be
+/// taken for a line ([`Slot::is_line`]).
+const LINE_NARROWING: f64 = 10.0;
+
 /// One mode on its way out: where its peak is and every estimate made of it.
 struct Slot {
     peak_hz: f64,
@@ -92,6 +96,20 @@ impl Slot {
     /// half-widths of its first estimate).
     fn fits(&self, f: &Estimate) -> bool {
         self.distance(f) < 3.0
+    }
+
+    /// Whether the spectrum fit made this peak a line: at least [`LINE_NARROWING`] times
+    /// narrower than the peak's half-power width, and its damping not told from 0 (ζ < 2σ_ζ).
+    /// The peak is then no mode: a broad bump the model can fill with nothing wider than the
+    /// data resolve. Seen on a sweep's whole-record periodogram, where one record's noise
+    /// stands up to ~9 dB over its neighbours: a logarithmic sweep through two low-pass
+    /// modes at 36.6 and 59.4 Hz (chirps seed 8's c16), whose response past them fell under
+    /// the sensor's noise, showed a bump of noise spikes at 84.2 Hz (half-power ζ 0.042,
+    /// 9 dB), fitted as 83.68 Hz, ζ 0.00087 ± 0.00065 and reported as a mode. Over 432 modes
+    /// of nine such batches no other fit was more than 3.2 times narrower than its peak.
+    fn is_line(&self, f: &Estimate) -> bool {
+        f.damping * LINE_NARROWING <= self.estimates[0].damping
+            && f.damping < 2.0 * f.damping_uncertainty
     }
 
     /// Adds a spectrum-fit estimate unless it wandered off the peak.
@@ -222,7 +240,17 @@ fn joint_fit(
             None => found.push(m),
         }
     }
-    place_seeded(&mut slots[..halves.len()], seeded);
+    // On a sweep's periodogram (one record, no averaging), a detected peak the fit made an
+    // unresolved line of is no mode (`Slot::is_line`): its slot goes.
+    let sweep = input
+        .window
+        .is_some_and(|w| w.kind == WindowKind::Rectangular);
+    let lines = place_seeded(&mut slots[..halves.len()], seeded, sweep);
+    let mut k = 0;
+    slots.retain(|_| {
+        k += 1;
+        !lines.get(k - 1).copied().unwrap_or(false)
+    });
     place_found(slots, found);
     Some(past_fit)
 }
@@ -234,7 +262,9 @@ fn joint_fit(
 /// fitted as 99.79 / 0.1365 from the first seed and 62.99 / 0.0269 from the second, and by
 /// seed the second slot took 62.99 Hz while the first kept its half-power seed: 61.98 and
 /// 62.99 Hz were reported, 99.8 Hz lost. A mode on no free peak is dropped (it wandered off).
-fn place_seeded(slots: &mut [Slot], seeded: Vec<Estimate>) {
+/// With `sweep`, a mode that is an unresolved line on its peak ([`Slot::is_line`]) is not
+/// added; the slots it fell on are returned marked (`true`), for the caller to drop.
+fn place_seeded(slots: &mut [Slot], seeded: Vec<Estimate>, sweep: bool) -> Vec<bool> {
     let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
     for (k, e) in seeded.iter().enumerate() {
         for (j, slot) in slots.iter().enumerate() {
@@ -245,13 +275,19 @@ fn place_seeded(slots: &mut [Slot], seeded: Vec<Estimate>) {
     }
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
     let (mut mode_done, mut slot_done) = (vec![false; seeded.len()], vec![false; slots.len()]);
+    let mut lines = vec![false; slots.len()];
     for (_, k, j) in pairs {
         if !mode_done[k] && !slot_done[j] {
             mode_done[k] = true;
             slot_done[j] = true;
-            slots[j].push_fit(seeded[k]);
+            if sweep && slots[j].is_line(&seeded[k]) {
+                lines[j] = true;
+            } else {
+                slots[j].push_fit(seeded[k]);
+            }
         }
     }
+    lines
 }
 
 /// Gives each mode found in the residuals (or split off a broad one) its slot. One that lands
@@ -902,7 +938,7 @@ mod tests {
             estimate(Method::SpectrumFit, 99.79, 0.1365),
             estimate(Method::SpectrumFit, 62.99, 0.0269),
         ];
-        place_seeded(&mut slots, seeded);
+        place_seeded(&mut slots, seeded, true);
         let modes: Vec<IdentifiedMode> = slots.into_iter().map(Slot::into_mode).collect();
         assert_eq!(
             modes
@@ -929,10 +965,47 @@ mod tests {
             estimate(Method::SpectrumFit, 50.2, 0.05),
             estimate(Method::SpectrumFit, 90.0, 0.05),
         ];
-        place_seeded(&mut slots, seeded);
+        place_seeded(&mut slots, seeded, true);
         assert_eq!(slots[0].estimates.len(), 2);
         assert_eq!(slots[0].estimates[1].frequency_hz, 50.2);
         assert_eq!(slots[1].estimates.len(), 1);
+    }
+
+    /// On a sweep, a fit that made its peak an unresolved line (≥ 10 times narrower than the
+    /// peak's half-power width, ζ < 2σ_ζ) marks the peak for dropping (chirps seed 8's c16:
+    /// 84.17 Hz, ζ 0.0423 fitted as 83.68 Hz, ζ 0.00087 ± 0.00065); a narrow fit whose
+    /// damping is determined, or one resolved from 0 only, is a mode; not on a spectrum.
+    #[test]
+    fn a_peak_fitted_as_an_unresolved_line_is_dropped_on_a_sweep() {
+        let line = |damping: f64, sigma: f64| Estimate {
+            damping_uncertainty: sigma,
+            ..estimate(Method::SpectrumFit, 83.68, damping)
+        };
+        let peaks = || {
+            vec![
+                slot(vec![estimate(Method::HalfPower, 36.61, 0.0148)]),
+                slot(vec![estimate(Method::HalfPower, 84.17, 0.0423)]),
+            ]
+        };
+        let fits = |l: Estimate| vec![estimate(Method::SpectrumFit, 36.59, 0.0128), l];
+        let mut slots = peaks();
+        assert_eq!(
+            place_seeded(&mut slots, fits(line(0.00087, 0.00065)), true),
+            [false, true]
+        );
+        assert_eq!(slots[1].estimates.len(), 1);
+        // Its damping told from 0 (2σ under ζ), or not narrow enough: a mode.
+        for l in [line(0.00087, 0.0004), line(0.0045, 0.004)] {
+            let mut slots = peaks();
+            assert_eq!(place_seeded(&mut slots, fits(l), true), [false, false]);
+            assert_eq!(slots[1].estimates.len(), 2);
+        }
+        // Not on a spectrum (Welch averages, a spectrum file).
+        let mut slots = peaks();
+        assert_eq!(
+            place_seeded(&mut slots, fits(line(0.00087, 0.00065)), false),
+            [false, false]
+        );
     }
 
     /// The defect of 344aa08 (a fast log sweep of `sweep_chirps.py`, chirps seed 1's c08):
