@@ -201,6 +201,8 @@ function render(st, canvases) {
         const result = api.renderPlayground(drawn, canvases);
         // A sampled shaper the worker designed (bounds) brings its cost report along (issue 23 item 2).
         kept.forEach((i, j) => { result.results[j].sampled ??= scheduler.designs.get(keys[i])?.report ?? null; });
+        // An si or direct shaper's solver report (`design`'s `solver`): polished or the grid solution.
+        kept.forEach((i, j) => { result.results[j].solver = scheduler.designs.get(keys[i])?.shaper?.solver ?? null; });
         return { result, kept, left, waiting, waitingKeys: waiting.map((i) => keys[i]) };
       } catch (e) {
         const j = shaperOf(e);

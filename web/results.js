@@ -47,6 +47,11 @@ export function showResults(result, st, kept) {
     rows.push(['Sampled: J_q of the minimum-norm shaper', of((s) => fmt(s.baselineCost.total, 4))]);
     rows.push(['Sampled: cost reduction against it (%)', of((s) => fmtPct(s.costReduction))]);
   }
+  // Whether the optimisation solver's polish converged (si, direct): a grid solution meets every
+  // constraint but may be up to a grid step longer, with the grid's many impulses.
+  if (results.some((r) => r.solver)) {
+    rows.push(['Optimisation solver', (r) => (r.solver ? (r.solver.polished ? 'polished' : 'grid solution (not polished)') : '—')]);
+  }
   syncRows($('summary').tBodies[0], rows.map(([name, f]) => [name, ...results.map((r) => f(r))]));
 
   showSimulation(result, color, st);

@@ -23,7 +23,7 @@ use crate::design::{DesignRequest, Guarantee, ShaperSpec};
 use crate::error::{Error, Result};
 use crate::mode::Mode;
 use crate::shaper::Shaper;
-use crate::solve::{self, Problem, ZeroVibration};
+use crate::solve::{self, Problem, SolverReport, ZeroVibration};
 use serde::{Deserialize, Serialize};
 
 /// Largest `derivatives` accepted by the direct design: the solver's limit.
@@ -80,7 +80,10 @@ impl DirectSpec {
 }
 
 /// Designs the direct multi-mode shaper; returns it with its guarantee.
-pub(crate) fn direct(spec: &DirectSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee)> {
+pub(crate) fn direct(
+    spec: &DirectSpec,
+    modes: &[Mode],
+) -> Result<(Shaper, Guarantee, SolverReport)> {
     if spec.derivatives > MAX_DIRECT_DERIVATIVES {
         return Err(Error::TooLarge {
             field: "derivatives".into(),
@@ -106,11 +109,13 @@ pub(crate) fn direct(spec: &DirectSpec, modes: &[Mode]) -> Result<(Shaper, Guara
         max_duration: spec.max_duration,
     };
     let design = solve::minimum_duration(&problem)?;
+    let report = design.report();
     Ok((
         design.shaper,
         Guarantee::ZeroDerivativesAtModes {
             derivatives: spec.derivatives,
         },
+        report,
     ))
 }
 
@@ -128,7 +133,7 @@ pub(crate) fn direct(spec: &DirectSpec, modes: &[Mode]) -> Result<(Shaper, Guara
 /// # Ok::<(), input_shaping::Error>(())
 /// ```
 pub fn direct_multi_mode(spec: &DirectSpec, modes: &[Mode]) -> Result<Shaper> {
-    let (shaper, guarantee) = direct(spec, modes)?;
+    let (shaper, guarantee, _) = direct(spec, modes)?;
     crate::design::verify(&shaper, modes, &guarantee)?;
     Ok(shaper)
 }

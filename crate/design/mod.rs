@@ -30,6 +30,7 @@ pub mod negative;
 use crate::error::{Error, Result};
 use crate::mode::{Mode, ModeSpec};
 use crate::shaper::Shaper;
+use crate::solve::SolverReport;
 use serde::{Deserialize, Serialize};
 
 pub use family::{FamilyInfo, ParamDefault, ParamInfo, ParamKind, Solver, FAMILIES};
@@ -265,6 +266,37 @@ pub fn design(request: &DesignRequest) -> Result<Shaper> {
     design_for(&request.shaper, &modes)
 }
 
+/// A designed shaper with how the optimisation solver reached it ([`design_report`]).
+#[derive(Debug, Clone)]
+pub struct Designed {
+    /// The shaper, as [`design`] returns it.
+    pub shaper: Shaper,
+    /// For a family the solver designs (`si`, `direct`): whether its polish converged, its
+    /// rounds and programs. `None` for the other families (closed forms, and `sampled`, whose
+    /// own report is [`sampled::design_for_modes`]'s).
+    pub solver: Option<SolverReport>,
+}
+
+/// [`design`] with the solver's report ([`Designed::solver`]): whether an `si` or `direct`
+/// shaper was polished (exact, locally optimal) or is the grid solution (up to a grid step
+/// longer, with the grid's many impulses).
+///
+/// ```
+/// use input_shaping::design::{design_report, specified::SiSpec};
+/// use input_shaping::{DesignRequest, ModeSpec, ShaperSpec};
+/// let request = DesignRequest {
+///     modes: vec![ModeSpec { frequency_hz: 2.0, damping: 0.05 }],
+///     shaper: ShaperSpec::Si(SiSpec { insensitivity: Some(0.3), ..SiSpec::default() }),
+/// };
+/// let designed = design_report(&request)?;
+/// assert!(designed.solver.is_some_and(|r| r.polished));
+/// # Ok::<(), input_shaping::Error>(())
+/// ```
+pub fn design_report(request: &DesignRequest) -> Result<Designed> {
+    let modes = Mode::list(&request.modes)?;
+    reported(&request.shaper, &modes, any_family)
+}
+
 /// Designs a shaper of family `spec` for already validated modes.
 ///
 /// ```
@@ -297,6 +329,11 @@ pub fn design_solved_for(spec: &ShaperSpec, modes: &[Mode]) -> Result<Shaper> {
     checked(spec, modes, solved_family)
 }
 
+/// [`design_solved_for`] with the solver's report, as [`design_report`] gives it.
+pub fn design_solved_report(spec: &ShaperSpec, modes: &[Mode]) -> Result<Designed> {
+    reported(spec, modes, solved_family)
+}
+
 /// A family's design for modes, with what it guarantees ([`any_family`], [`solved_family`]).
 type Family = fn(&ShaperSpec, &[Mode]) -> Result<(Shaper, Guarantee)>;
 
@@ -308,6 +345,31 @@ fn checked(spec: &ShaperSpec, modes: &[Mode], family: Family) -> Result<Shaper> 
     let (shaper, guarantee) = family(spec, modes)?;
     verify(&shaper, modes, &guarantee)?;
     Ok(shaper)
+}
+
+/// [`checked`] with the solver's report for `si` and `direct` (their designs are asked for
+/// here, the others through `family`). A path of its own, so that the page's first module,
+/// which designs through [`design_for`] and never reports, does not carry it.
+fn reported(spec: &ShaperSpec, modes: &[Mode], family: Family) -> Result<Designed> {
+    if modes.is_empty() {
+        return Err(Error::invalid("modes", "at least one mode is required"));
+    }
+    let solved = match spec {
+        ShaperSpec::Si(si) => specified::si(si, modes)?,
+        ShaperSpec::Direct(d) => direct::direct(d, modes)?,
+        _ => {
+            return checked(spec, modes, family).map(|shaper| Designed {
+                shaper,
+                solver: None,
+            })
+        }
+    };
+    let (shaper, guarantee, report) = solved;
+    verify(&shaper, modes, &guarantee)?;
+    Ok(Designed {
+        shaper,
+        solver: Some(report),
+    })
 }
 
 /// Any family's design and what it guarantees (the solved ones through [`solved_family`]).
@@ -396,8 +458,8 @@ fn solved_family(spec: &ShaperSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee
             sampled::design_for_modes(modes, spec)?.shaper,
             Guarantee::ZeroAtModes,
         )),
-        ShaperSpec::Si(si) => specified::si(si, modes),
-        ShaperSpec::Direct(d) => direct::direct(d, modes),
+        ShaperSpec::Si(si) => specified::si(si, modes).map(|(s, g, _)| (s, g)),
+        ShaperSpec::Direct(d) => direct::direct(d, modes).map(|(s, g, _)| (s, g)),
         other => Err(Error::invalid(
             "family",
             format!(

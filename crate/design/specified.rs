@@ -34,7 +34,7 @@ use crate::design::{DesignRequest, Guarantee, ShaperSpec};
 use crate::error::{finite, positive, Error, Result};
 use crate::mode::Mode;
 use crate::shaper::Shaper;
-use crate::solve::{self, Band, Limit, Problem, Tolerance};
+use crate::solve::{self, Band, Limit, Problem, SolverReport, Tolerance};
 use serde::{Deserialize, Serialize};
 
 /// Most sampled frequencies accepted.
@@ -335,7 +335,7 @@ fn sampled_limits(
 
 /// Designs an SI shaper for `modes`; returns it with the guarantee to verify: V ≤ Vtol at every
 /// sampled point (sampled mode), or at every point of the dense check over each band.
-pub(crate) fn si(spec: &SiSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee)> {
+pub(crate) fn si(spec: &SiSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee, SolverReport)> {
     let problem = problem(spec, modes)?;
     let design = solve::minimum_duration(&problem)?;
     if let Some(max) = spec.max_impulses {
@@ -355,7 +355,8 @@ pub(crate) fn si(spec: &SiSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee)> {
         points: design.checked.clone(),
         tolerance: solve::CHECK_TOLERANCE,
     };
-    Ok((design.shaper, guarantee))
+    let report = design.report();
+    Ok((design.shaper, guarantee, report))
 }
 
 /// Designs an SI shaper for `modes` (see the module docs), checked against its guarantee.
@@ -373,7 +374,7 @@ pub(crate) fn si(spec: &SiSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee)> {
 /// # Ok::<(), input_shaping::Error>(())
 /// ```
 pub fn specified_insensitivity(spec: &SiSpec, modes: &[Mode]) -> Result<Shaper> {
-    let (shaper, guarantee) = si(spec, modes)?;
+    let (shaper, guarantee, _) = si(spec, modes)?;
     crate::design::verify(&shaper, modes, &guarantee)?;
     Ok(shaper)
 }

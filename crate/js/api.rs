@@ -107,8 +107,22 @@ fn mode_from_js(value: JsValue, what: &str) -> Result<Mode, Error> {
     Mode::from_spec(&spec).map_err(|e| e.within(what))
 }
 
+/// `design(spec)`'s result: the shaper's wire form ([`ShaperData`]'s keys, in its order) and,
+/// for `si` and `direct`, the solver's report.
+#[cfg(any(feature = "js-api", feature = "js-designer"))]
+#[derive(Serialize)]
+struct DesignedOut {
+    impulses: Vec<crate::shaper::Impulse>,
+    duration: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    factors: Option<Vec<Vec<crate::shaper::Impulse>>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    solver: Option<crate::solve::SolverReport>,
+}
+
 /// `design(spec)`: `spec = { family, modes: [{ frequencyHz, damping }], …parameters }` →
-/// `{ impulses: [{ time, amplitude }], duration }`.
+/// `{ impulses: [{ time, amplitude }], duration }`, plus `solver: { polished, rounds,
+/// programs }` for the families the optimisation solver designs (`si`, `direct`).
 #[cfg(any(feature = "js-api", feature = "js-designer"))]
 #[wasm_bindgen(unchecked_return_type = "Shaper")]
 pub fn design(
@@ -116,13 +130,23 @@ pub fn design(
 ) -> Result<JsValue, JsValue> {
     let request: DesignRequest = from_js_root(spec, "spec").map_err(js_error)?;
     #[cfg(feature = "js-api")]
-    let shaper = design::design(&request).map_err(js_error)?;
+    let designed = design::design_report(&request).map_err(js_error)?;
     // The page's design worker's module: the solved families alone (README, *Playground*).
     #[cfg(not(feature = "js-api"))]
-    let shaper = Mode::list(&request.modes)
-        .and_then(|modes| design::design_solved_for(&request.shaper, &modes))
+    let designed = Mode::list(&request.modes)
+        .and_then(|modes| design::design_solved_report(&request.shaper, &modes))
         .map_err(js_error)?;
-    to_js(&shaper.to_data())
+    let ShaperData {
+        impulses,
+        duration,
+        factors,
+    } = designed.shaper.to_data();
+    to_js(&DesignedOut {
+        impulses,
+        duration,
+        factors,
+        solver: designed.solver,
+    })
 }
 
 /// `residualVibration(shaper, { frequencyHz, damping })` → V as a fraction (1 = unshaped).

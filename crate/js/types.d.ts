@@ -53,6 +53,21 @@ export interface Shaper {
    * factors' impulses (one shaper's each), whose convolution `impulses` is. V of the shaper is
    * the product of the factors' V. Ignored when the shaper is passed back. */
   factors?: Impulse[][];
+  /** Only from `design` of a family the optimisation solver designs (`si`, `direct`): how it
+   * was reached. Ignored when the shaper is passed back. */
+  solver?: SolverReport;
+}
+
+/** How the optimisation solver reached an `si` or `direct` design (`design(spec).solver`). */
+export interface SolverReport {
+  /** The Newton polish converged: the shaper is exact and locally optimal. `false`: it is the
+   * grid solution — it meets every constraint, but it may be up to a grid step longer than
+   * the optimum and has the grid's impulses (often many). */
+  polished: boolean;
+  /** Rounds of the exchange loop (1 when the first design met every band). */
+  rounds: number;
+  /** Convex programs solved. */
+  programs: number;
 }
 
 /** A shaper as the functions take it: `duration` is optional and ignored. */

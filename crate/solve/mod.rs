@@ -223,6 +223,21 @@ pub struct Problem {
 /// A point at which a design was checked: (frequency in Hz, damping ratio, Vtol there).
 pub type CheckedPoint = (f64, f64, f64);
 
+/// How the optimisation solver reached a design: the part of [`Design`] a caller of
+/// [`crate::design::design_report`] sees (JS: `design(spec).solver`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct SolverReport {
+    /// Whether the Newton polish converged: the shaper is then exact and locally optimal.
+    /// Otherwise it is the grid solution: it meets every constraint, but it is up to a grid
+    /// step longer than the optimum and its impulses are the grid's (often many).
+    pub polished: bool,
+    /// Rounds of the exchange loop (1 when the first design already met every band).
+    pub rounds: usize,
+    /// Convex programs solved.
+    pub programs: usize,
+}
+
 /// The result of [`minimum_duration`].
 #[derive(Debug, Clone)]
 pub struct Design {
@@ -238,6 +253,17 @@ pub struct Design {
     pub programs: usize,
     /// Rounds of the exchange loop (1 when the first design already met every band).
     pub rounds: usize,
+}
+
+impl Design {
+    /// What the caller of a solved family sees of the design ([`SolverReport`]).
+    pub fn report(&self) -> SolverReport {
+        SolverReport {
+            polished: self.polished,
+            rounds: self.rounds,
+            programs: self.programs,
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

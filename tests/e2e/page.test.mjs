@@ -252,7 +252,21 @@ test('a link with a solved family draws with the page\'s module and adds the sol
   // A 0.5 Hz shaper smooths more than Klipper's 0.12 mm target at any acceleration: Klipper's
   // max accel is 0, said in words.
   assert.deepEqual((await summary(page))['Klipper max accel, smoothing ≤ 0.12 mm (mm/s²)'], ['0 (none keeps smoothing ≤ 0.12 mm)', '0 (none keeps smoothing ≤ 0.12 mm)']);
+  // The solver's report (`design`'s `solver`): this SI polished; the ZVD has none.
+  assert.deepEqual((await summary(page))['Optimisation solver'], ['polished', '—']);
   await page.screenshot({ path: `${SCREENSHOTS}si-link-1280x800.png`, fullPage: true });
+  // 1 and 3 Hz at I 0.5 (ζ 0.02, Vtol 5 %) falls back to the grid solution (tests/specified.rs,
+  // the_design_report_says_whether_the_polish_converged): said in the table.
+  const fallback = {
+    modes: [{ frequencyHz: 1, damping: 0.02 }, { frequencyHz: 3, damping: 0.02 }],
+    shapers: [{ family: 'si', vtol: 0.05, insensitivity: 0.5 }, { family: 'zvd' }],
+  };
+  await page.evaluate((s) => { location.hash = `#state=${encodeURIComponent(JSON.stringify(s))}`; }, fallback);
+  await settle(page);
+  await page.waitForFunction(() => document.getElementById('general-error').textContent === '', null, { timeout: 30000 })
+    .catch(() => {});
+  assert.deepEqual((await summary(page))['Optimisation solver'], ['grid solution (not polished)', '—']);
+  assert.ok(Number((await summary(page)).Impulses[0]) > 30, JSON.stringify((await summary(page)).Impulses));
   // Back to a state without a solved family.
   await page.evaluate(() => { location.hash = `#state=${encodeURIComponent(JSON.stringify({ modes: [{ frequencyHz: 2, damping: 0.05 }], shapers: [{ family: 'zvd' }] }))}`; });
   await settle(page);

@@ -64,6 +64,9 @@ export async function main(canvas: HTMLCanvasElement): Promise<void> {
     modes: [mode],
   });
   const first: number = zvd.impulses[0].time + ei.duration + si.impulses.length + sampled.duration + custom.duration;
+  // A solved family's design says whether its polish converged (absent for the others).
+  const polished: boolean | undefined = si.solver?.polished;
+  console.log(polished, si.solver?.rounds, si.solver?.programs);
 
   // A spec built elsewhere, narrowed by its family.
   const spec: DesignSpec = { family: "eihump", humps: 3, modes: [mode] };
