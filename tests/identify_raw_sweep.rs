@@ -419,6 +419,30 @@ fn a_line_fitted_into_a_sweeps_noise_is_no_mode() {
     );
 }
 
+/// A linear sweep, 5 → 197 Hz in 5.1 s at 3.2 kHz, through a base-excited 63.6 Hz, ζ 0.045
+/// mode and two weak broad ones, 92.7 / 0.163 and 151.3 / 0.151 (fixture `linhump63`,
+/// sweep_chirps.py seed 10's c19). The 62.5 Hz peak (half-power 62.28 Hz, ζ 0.059) was fitted
+/// as a hump, 61.48 Hz ζ 0.68, and reported so until 2026-12-07. Such a fit is not the peak's:
+/// the peak's own estimate stays, within 3 % and ζ under 0.1. (Not within issue 20's targets:
+/// 2.1 % and +33 %, the two weak modes leaning on it.)
+#[test]
+fn a_hump_far_broader_than_its_peak_is_not_its_fit() {
+    let id = identified_file(include_str!("data/sweeps/raw_data_x_linhump63.csv"));
+    assert!(id.sweep.is_some(), "no sweep");
+    let near: Vec<_> = id
+        .modes
+        .iter()
+        .filter(|m| (m.frequency_hz / 63.63 - 1.0).abs() < 0.05)
+        .collect();
+    assert_eq!(near.len(), 1, "{:?}", id.modes);
+    let m = near[0];
+    assert!(
+        (m.frequency_hz / 63.63 - 1.0).abs() < 0.03 && m.damping < 0.1,
+        "{m:?}"
+    );
+    assert!(id.modes.iter().all(|m| m.damping < 0.3), "{:?}", id.modes);
+}
+
 /// A sweep over a band that holds no mode (one mode at 8 Hz, swept 30–80 Hz at 2 Hz/s):
 /// the sweep is reported, no mode, and a note says why. Before, a sweep whose band showed no
 /// peak was dropped and the recording went the Welch path, which is not for sweeps, and
