@@ -985,7 +985,8 @@ mod tests {
     /// On a sweep, a fit that made its peak an unresolved line (≥ 10 times narrower than the
     /// peak's half-power width, ζ < 2σ_ζ) marks the peak for dropping (chirps seed 8's c16:
     /// 84.17 Hz, ζ 0.0423 fitted as 83.68 Hz, ζ 0.00087 ± 0.00065); a narrow fit whose
-    /// damping is determined, or one resolved from 0 only, is a mode; not on a spectrum.
+    /// damping is determined, or an undetermined one less than ten times narrower, is the
+    /// peak's mode; on a spectrum, either is.
     #[test]
     fn a_peak_fitted_as_an_unresolved_line_is_dropped_on_a_sweep() {
         let line = |damping: f64, sigma: f64| Estimate {
@@ -1005,7 +1006,7 @@ mod tests {
             [false, true]
         );
         assert_eq!(slots[1].estimates.len(), 1);
-        // Its damping told from 0 (2σ under ζ), or not narrow enough: a mode.
+        // Its damping told from 0 (2σ under ζ), or 9.4 times narrower only: the peak's mode.
         for l in [line(0.00087, 0.0004), line(0.0045, 0.004)] {
             let mut slots = peaks();
             assert_eq!(place_seeded(&mut slots, fits(l), true), [false, false]);
