@@ -199,10 +199,13 @@ function render(st, canvases) {
       drawn.designed = kept.map((i) => scheduler.designs.get(keys[i])?.shaper ?? null);
       try {
         const result = api.renderPlayground(drawn, canvases);
-        // A sampled shaper the worker designed (bounds) brings its cost report along (issue 23 item 2).
-        kept.forEach((i, j) => { result.results[j].sampled ??= scheduler.designs.get(keys[i])?.report ?? null; });
-        // An si or direct shaper's solver report (`design`'s `solver`): polished or the grid solution.
-        kept.forEach((i, j) => { result.results[j].solver = scheduler.designs.get(keys[i])?.shaper?.solver ?? null; });
+        // What the worker's design brings along: a sampled shaper's cost report (bounds; issue 23
+        // item 2), an si or direct shaper's solver report (`design`'s `solver`: polished or not).
+        kept.forEach((i, j) => {
+          const known = scheduler.designs.get(keys[i]);
+          result.results[j].sampled ??= known?.report ?? null;
+          result.results[j].solver = known?.shaper?.solver ?? null;
+        });
         return { result, kept, left, waiting, waitingKeys: waiting.map((i) => keys[i]) };
       } catch (e) {
         const j = shaperOf(e);

@@ -354,17 +354,13 @@ fn reported(spec: &ShaperSpec, modes: &[Mode], family: Family) -> Result<Designe
     if modes.is_empty() {
         return Err(Error::invalid("modes", "at least one mode is required"));
     }
-    let solved = match spec {
-        ShaperSpec::Si(si) => specified::si(si, modes)?,
-        ShaperSpec::Direct(d) => direct::direct(d, modes)?,
-        _ => {
-            return checked(spec, modes, family).map(|shaper| Designed {
-                shaper,
-                solver: None,
-            })
-        }
+    let Some(solved) = reporting(spec, modes) else {
+        return checked(spec, modes, family).map(|shaper| Designed {
+            shaper,
+            solver: None,
+        });
     };
-    let (shaper, guarantee, report) = solved;
+    let (shaper, guarantee, report) = solved?;
     verify(&shaper, modes, &guarantee)?;
     Ok(Designed {
         shaper,
@@ -453,13 +449,14 @@ fn any_family(spec: &ShaperSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee)> 
 /// The solved families' designs (`sampled`, `si`, `direct`) and what they guarantee; any other
 /// family is refused at `family`.
 fn solved_family(spec: &ShaperSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee)> {
+    if let Some(solved) = reporting(spec, modes) {
+        return solved.map(|(shaper, guarantee, _)| (shaper, guarantee));
+    }
     match spec {
         ShaperSpec::Sampled(spec) => Ok((
             sampled::design_for_modes(modes, spec)?.shaper,
             Guarantee::ZeroAtModes,
         )),
-        ShaperSpec::Si(si) => specified::si(si, modes).map(|(s, g, _)| (s, g)),
-        ShaperSpec::Direct(d) => direct::direct(d, modes).map(|(s, g, _)| (s, g)),
         other => Err(Error::invalid(
             "family",
             format!(
@@ -467,6 +464,19 @@ fn solved_family(spec: &ShaperSpec, modes: &[Mode]) -> Result<(Shaper, Guarantee
                 other.name()
             ),
         )),
+    }
+}
+
+/// The solved families whose design reports how the solver reached it (`si`, `direct`): their
+/// design, guarantee and [`SolverReport`]; None for any other family.
+fn reporting(
+    spec: &ShaperSpec,
+    modes: &[Mode],
+) -> Option<Result<(Shaper, Guarantee, SolverReport)>> {
+    match spec {
+        ShaperSpec::Si(si) => Some(specified::si(si, modes)),
+        ShaperSpec::Direct(d) => Some(direct::direct(d, modes)),
+        _ => None,
     }
 }
 

@@ -252,10 +252,7 @@ fn joint_fit(
     }
     // On a sweep's periodogram (one record, no averaging), a detected peak the fit made an
     // unresolved line of is no mode (`Slot::is_line`): its slot goes.
-    let sweep = input
-        .window
-        .is_some_and(|w| w.kind == WindowKind::Rectangular);
-    let lines = place_seeded(&mut slots[..halves.len()], seeded, sweep);
+    let lines = place_seeded(&mut slots[..halves.len()], seeded, input.one_record());
     let mut k = 0;
     slots.retain(|_| {
         k += 1;

@@ -82,6 +82,16 @@ pub(crate) struct ModelInput<'a> {
     pub residual_standing_db: f64,
 }
 
+impl ModelInput<'_> {
+    /// Whether the bins are one record's periodogram (a sweep's whole record, rectangular
+    /// window: nothing averaged), whose noise spikes stand higher than a Welch average's or a
+    /// spectrum file's.
+    pub fn one_record(&self) -> bool {
+        self.window
+            .is_some_and(|w| w.kind == WindowKind::Rectangular)
+    }
+}
+
 /// A seed: natural frequency, damping, PSD at the peak.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Seed {
@@ -1125,12 +1135,9 @@ impl<'a> Setup<'a> {
                 input.residual_standing_db
             };
             let (fk, zk) = (x[3 * k].exp(), x[3 * k + 1].exp());
-            let sweep = input
-                .window
-                .is_some_and(|w| w.kind == WindowKind::Rectangular);
             problem.standing_db(x, trial.len(), k) >= need_db
                 && zk < 0.3
-                && (!sweep || problem.resolved(fk, zk))
+                && (!input.one_record() || problem.resolved(fk, zk))
         });
         let kept = problem.others_stand(x, trial.len(), new);
         (stands && kept && bic(&candidate.0, self.n_eff) < bic(&best.0, self.n_eff) - 10.0)
