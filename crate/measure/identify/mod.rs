@@ -106,7 +106,7 @@ impl Slot {
     /// modes at 36.6 and 59.4 Hz (chirps seed 8's c16), whose response past them fell under
     /// the sensor's noise, showed a bump of noise spikes at 84.2 Hz (half-power ζ 0.042,
     /// 9 dB), fitted as 83.68 Hz, ζ 0.00087 ± 0.00065 and reported as a mode. Over 432 modes
-    /// of nine such batches no other fit was more than 3.2 times narrower than its peak.
+    /// of nine such batches no other fit a peak kept was more than 3.2 times narrower than it.
     fn is_line(&self, f: &Estimate) -> bool {
         f.damping * WIDTH_FACTOR <= self.estimates[0].damping
             && f.damping < 2.0 * f.damping_uncertainty
