@@ -25,17 +25,11 @@ pub(super) fn detect_within(
 ) -> Vec<Peak> {
     let [lo, hi] = context;
     let sm = smoothed_db(&to_db(&psd.psd[lo..=hi]), 0, hi - lo, h);
-    let n = sm.len();
-    let (lefts, rights) = bases(&sm);
     let mut peaks = Vec::new();
-    for i in 1..n.saturating_sub(1) {
+    for (i, prominence) in maxima(&sm) {
         if lo + i < band[0] || lo + i > band[1] {
             continue;
         }
-        if !(sm[i] > sm[i - 1] && sm[i] >= sm[i + 1]) {
-            continue;
-        }
-        let prominence = sm[i] - lefts[i].max(rights[i]);
         if prominence >= min_db {
             // The raw maximum near the smoothed one.
             let k0 = lo + i;
@@ -56,6 +50,18 @@ pub(super) fn detect_within(
     peaks.truncate(max_modes);
     crate::sort::sort_by(&mut peaks, |a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     peaks
+}
+
+/// The local maxima of `sm` (a value above its left neighbour and not below its right one; the
+/// ends are none) with their topographic prominence: the height over the higher of their two
+/// [`bases`].
+pub(super) fn maxima(sm: &[f64]) -> Vec<(usize, f64)> {
+    let n = sm.len();
+    let (lefts, rights) = bases(sm);
+    (1..n.saturating_sub(1))
+        .filter(|&i| sm[i] > sm[i - 1] && sm[i] >= sm[i + 1])
+        .map(|i| (i, sm[i] - lefts[i].max(rights[i])))
+        .collect()
 }
 
 /// Each value's bases: the lowest value between it and the nearest higher one on its left
