@@ -1468,11 +1468,11 @@ mod tests {
         }
     }
 
-    /// `bump_seeds` seeds the bumps that stand ≥ 1.5 dB (3-bin means) on a fitted mode's flank (45 Hz beside a
-    /// 64 Hz, ζ 0.2 mode: 19 Hz away, within three half-power widths), and not one under
-    /// 1.5 dB (38 Hz), one inside the mode's half-power band (70 Hz), one beyond its flank
-    /// (170 Hz, where an old file's harmonics lie), or one on a seed (62 Hz); the most
-    /// prominent first, as many as there is room for.
+    /// `bump_seeds` seeds the bumps that stand ≥ 1.5 dB (3-bin means) on a fitted mode's flank
+    /// (45 and 30 Hz beside a 64 Hz, ζ 0.2 mode: within three half-power widths), and not one
+    /// under 1.5 dB (38 Hz), one inside the mode's half-power band (70 Hz), one beyond its
+    /// flank (170 Hz, where an old file's harmonics lie), or one on a seed (62 Hz); the most
+    /// prominent first, as many as there is room for. Each exclusion removed fails it.
     #[test]
     fn bumps_are_seeded_on_a_flank_only() {
         let df = 1.5625;
