@@ -979,17 +979,17 @@ fn humps(problem: &Problem, f0: f64, z0: f64, others: &[(f64, f64)]) -> Option<(
             .iter()
             .any(|&(fj, zj)| (g - fj).abs() <= (2.0 * zj * fj).max(2.0 * df))
     };
-    let maxima: Vec<usize> = (1..n.saturating_sub(1))
-        .filter(|&j| {
-            fk[j] >= lo && fk[j] <= hi && sm[j] > sm[j - 1] && sm[j] >= sm[j + 1] && !theirs(fk[j])
-        })
+    let tops: Vec<usize> = maxima(&sm)
+        .into_iter()
+        .map(|(j, _)| j)
+        .filter(|&j| fk[j] >= lo && fk[j] <= hi && !theirs(fk[j]))
         .collect();
-    let &top = maxima.iter().max_by(|&&a, &&b| sm[a].total_cmp(&sm[b]))?;
+    let &top = tops.iter().max_by(|&&a, &&b| sm[a].total_cmp(&sm[b]))?;
     let depth = |j: usize| {
         let (a, b) = (j.min(top), j.max(top));
         sm[j] - sm[a..=b].iter().cloned().fold(f64::INFINITY, f64::min)
     };
-    let &other = maxima
+    let &other = tops
         .iter()
         .filter(|&&j| j != top)
         .max_by(|&&a, &&b| depth(a).total_cmp(&depth(b)))?;
