@@ -541,6 +541,36 @@ fn modes_under_the_prominence_are_tried_together() {
     assert!(tally.spurious.is_empty(), "spurious modes");
 }
 
+/// A seeded mode the fit trades for one found later (`sweep_random.py` seed 58's machine f10:
+/// 83.77 Hz ζ 0.147 and 114.49 Hz ζ 0.048, gains 0.82 and 0.18, swept to 133.3 Hz at 4 Hz/s),
+/// written from closed forms (K = 400). Only the 114.5 Hz peak is detected; its seed's fit goes to the
+/// broad mode, a mode from the residuals then takes the 114.5 Hz peak, and the seed's mode,
+/// on no peak, was dropped: one mode reported. Both are found within issue 20's targets on
+/// each of three noise draws (`place_wandered` in identify/mod.rs), and nothing more.
+#[test]
+fn a_seed_traded_for_a_mode_found_later_is_kept() {
+    let modes = [(83.77, 0.1469, 0.8244), (114.49, 0.0482, 0.1756)];
+    let truth: Vec<(f64, f64)> = modes.iter().map(|m| (m.0, m.1)).collect();
+    let mut tally = Tally::default();
+    let mut rng = Rng(58);
+    for draw in 0..3 {
+        let text = synthetic_resonances(&modes, 20.0, 400, 133.3, &mut rng);
+        let name = format!("resonances_y_traded_{draw}.csv");
+        let spectrum = spectrum_of(&text, &name);
+        let id = identify_spectrum(&spectrum, &IdentifyOptions::new(f64::NAN)).unwrap();
+        assert_eq!(id.modes.len(), 2, "{name}: {:?}", found_of(&id.modes));
+        let half_bin = 0.5 * spectrum.resolution_hz;
+        tally.check(&name, "synthetic", &truth, &found_of(&id.modes), half_bin);
+    }
+    tally.print(false);
+    assert_eq!(
+        tally.within(),
+        tally.rows.len(),
+        "modes outside the targets"
+    );
+    assert!(tally.spurious.is_empty(), "spurious modes");
+}
+
 /// The sweep's end read as a mode (issue 20; docs/measured-data.md, *The end of the sweep*):
 /// resonances files written from closed forms whose sweep ends at 133.3 Hz, as Klipper's
 /// releases of 2021–2023 did (rows to 200 Hz), with a mode 15 Hz under the end (the response
