@@ -264,14 +264,20 @@ fn joint_fit(
         .into_iter()
         .zip(placed)
         .filter_map(|((i, m), placed)| (!placed).then_some((halves[i].peak_hz, m)));
-    place_wandered(slots, wandered, input.residual_standing_db);
+    place_wandered(
+        slots,
+        wandered,
+        input.residual_standing_db,
+        input.rough_below_hz,
+    );
     Some(past_fit)
 }
 
 /// Gives a mode seeded on a detected peak that the fit moved off every free peak a slot of its
 /// own, when another fitted mode took the peak it left (the slot holds a spectrum-fit
 /// estimate now: the model that was kept has both) and it stands as a mode found in the
-/// residuals must (`standing_db`, ζ < 0.3) on no other slot. The fit may trade a seed for a
+/// residuals must (`standing_db`, [`model::ROUGH_STANDING_DB`] below `rough_below_hz`;
+/// ζ < 0.3) on no other slot. The fit may trade a seed for a
 /// mode found later: a resonances file (`sweep_random.py` seed 58's f10: 83.8 / 0.147 and
 /// 114.5 / 0.048, only the 114.5 Hz peak detected) fitted the seed at 75.4 / 0.164 (the broad
 /// mode), then the residual mode seeded at 115.6 Hz converged to 115.06 / 0.040 and the seed
@@ -282,13 +288,19 @@ fn place_wandered(
     slots: &mut Vec<Slot>,
     wandered: impl Iterator<Item = (f64, FittedMode)>,
     standing_db: f64,
+    rough_below_hz: f64,
 ) {
     for (left_hz, m) in wandered {
+        let need_db = if m.estimate.frequency_hz < rough_below_hz {
+            model::ROUGH_STANDING_DB
+        } else {
+            standing_db
+        };
         let taken = slots.iter().any(|s| {
             s.peak_hz == left_hz && s.estimates.iter().any(|e| e.method == Method::SpectrumFit)
         });
         let elsewhere = slots.iter().any(|s| s.fits(&m.estimate));
-        if taken && !elsewhere && m.standing_db >= standing_db && m.estimate.damping < 0.3 {
+        if taken && !elsewhere && m.standing_db >= need_db && m.estimate.damping < 0.3 {
             slots.push(Slot {
                 peak_hz: m.estimate.frequency_hz,
                 peak_psd: m.peak_psd,
@@ -1123,8 +1135,8 @@ mod tests {
 
     /// A seeded mode the fit moved off every peak (seed 58's f10: seeded at 114.5 Hz, ended at
     /// 83.6 Hz, ζ 0.133) is a mode of its own once another fitted mode took the peak it left,
-    /// when it stands as a residual mode must (3 dB on a spectrum) with ζ < 0.3 on no slot of
-    /// its own; otherwise it is dropped, as before.
+    /// when it stands as a residual mode must (3 dB on a spectrum, 8 dB where a fast sweep's
+    /// drive is rough) with ζ < 0.3 on no slot of its own; otherwise it is dropped, as before.
     #[test]
     fn a_seed_traded_for_a_later_mode_keeps_its_fit() {
         let peak = || vec![slot(vec![estimate(Method::HalfPower, 114.5, 0.058)])];
@@ -1139,6 +1151,7 @@ mod tests {
             &mut slots,
             [(114.5, wandered(83.6, 0.133, 9.0))].into_iter(),
             3.0,
+            0.0,
         );
         let modes: Vec<IdentifiedMode> = slots.into_iter().map(Slot::into_mode).collect();
         assert_eq!(modes.len(), 2);
@@ -1152,14 +1165,26 @@ mod tests {
             &mut slots,
             [(114.5, wandered(83.6, 0.133, 9.0))].into_iter(),
             3.0,
+            0.0,
         );
         assert_eq!(slots.len(), 1);
         // Standing under the threshold, as broad as ζ 0.3, or on another slot: dropped.
         for (f, z, db) in [(83.6, 0.133, 2.9), (83.6, 0.3, 9.0), (115.5, 0.05, 9.0)] {
             let mut slots = peak();
             place_found(&mut slots, vec![found(115.06, 0.040)]);
-            place_wandered(&mut slots, [(114.5, wandered(f, z, db))].into_iter(), 3.0);
+            place_wandered(
+                &mut slots,
+                [(114.5, wandered(f, z, db))].into_iter(),
+                3.0,
+                0.0,
+            );
             assert_eq!(slots.len(), 1, "{f} {z} {db}");
         }
+        // Where a fast sweep's drive is rough, it must stand 8 dB.
+        let mut slots = peak();
+        place_found(&mut slots, vec![found(115.06, 0.040)]);
+        let rough = [(114.5, wandered(83.6, 0.133, 7.9))].into_iter();
+        place_wandered(&mut slots, rough, 3.0, 90.0);
+        assert_eq!(slots.len(), 1);
     }
 }

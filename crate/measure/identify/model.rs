@@ -1251,11 +1251,11 @@ impl<'a> Setup<'a> {
     /// them, which a misfit's residual is not), and one fitted mode stays on each hump
     /// (within a quarter of their separation or its own half-power half-width: a broad mode's
     /// hump sits off its peak on a neighbour's flank, `sweep_random.py` seed 53's f34 73.78 /
-    /// 0.132 seeded at 69.6 Hz) — the broadest such mode first. Two modes whose
-    /// peaks are a few dB apart with a shallow dip between
-    /// them (ratio 1.2–1.45, ζ 0.04–0.12: 3–6 dB) fit as one broad mode better than as
-    /// nothing, and a mode from the residuals is sought only outside a fitted mode's band, so
-    /// without this step they came out as one mode at neither frequency
+    /// 0.132 seeded at 69.6 Hz) — the broadest such mode first. Two modes whose peaks are a
+    /// few dB apart with a shallow dip between them (ratio 1.2–1.45, ζ 0.04–0.12: 3–6 dB) fit
+    /// as one broad mode better than as nothing, and a mode from the residuals is sought only
+    /// outside a fitted mode's band, so without this step they came out as one mode at
+    /// neither frequency
     /// (docs/measured-data.md, *Close pairs*).
     fn split(
         &self,
@@ -1324,7 +1324,7 @@ pub(crate) const SPECTRUM_STANDING_DB: f64 = 3.0;
 /// lumpy by ±3–7 dB over a few hertz, which the fit otherwise takes for modes (Klipper's
 /// pulse train swept 5–200 Hz in 2 s: 19.8 and 27.6 Hz, standing 3.9 and 6.3 dB, in a record
 /// with one 77.7 Hz mode).
-const ROUGH_STANDING_DB: f64 = 8.0;
+pub(crate) const ROUGH_STANDING_DB: f64 = 8.0;
 
 /// Fits the modes from `seeds` jointly, then adds modes while the information criterion says
 /// so (up to `max_modes`): one found in the residuals, a broad mode split in two where the
