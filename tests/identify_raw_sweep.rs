@@ -631,12 +631,12 @@ fn a_mode_near_a_fast_sweeps_start_is_found() {
     );
 }
 
-/// Klipper's whole test (5–200 Hz) through a sharp mode, a broad one 6 dB under it and a
-/// strong broad one above (`sweep_random.py --whole-raw` seed 58's f07 at 1 Hz/s: 47.35 /
+/// Klipper's whole test (5–200 Hz) through a sharp mode, a broad one about 6 dB under it and
+/// a strong broad one above (`sweep_random.py --whole-raw` seed 58's f07 at 1 Hz/s: 47.35 /
 /// 0.021, 81.84 / 0.069, 104.98 / 0.127; seed 53's f34 at 2 Hz/s: 54.69 / 0.016, 73.78 /
-/// 0.132, 125.25 / 0.105), here through Klipper's drive. The fit read two of them as one
-/// broad mode (f07: 76.3 / 0.20 and 110.5 / 0.114 beside 47.0; f34: 53.5 / 0.150 over the
-/// lower two, 128.1 / 0.089). The split on its two humps found all three, and was refused
+/// 0.132, 125.25 / 0.105), here through Klipper's drive. The fit misread the broad ones
+/// (f07: 76.3 / 0.20 and 110.5 / 0.114 beside 47.0; f34: one broad mode 53.5 / 0.150 over
+/// the lower two, and 128.1 / 0.089). The split on the humps found all three, and was refused
 /// twice: its weaker mode stood 3.1–4.8 dB over the model without it, where a sweep's
 /// residual modes must stand 5 dB (a split's two modes now need the 3 dB a spectrum's do,
 /// `SPECTRUM_STANDING_DB` in identify/model.rs), and f34's broad mode ended at 73.7 Hz,
