@@ -85,6 +85,17 @@ struct Slot {
 }
 
 impl Slot {
+    /// The slot of a fitted mode on no detected peak: at its own frequency, its standing over
+    /// the model without it as its prominence.
+    fn of_fit(m: &FittedMode) -> Self {
+        Slot {
+            peak_hz: m.estimate.frequency_hz,
+            peak_psd: m.peak_psd,
+            prominence_db: m.standing_db,
+            estimates: vec![m.estimate],
+        }
+    }
+
     /// How far a spectrum-fit estimate lies from this slot's peak, in half-power half-widths
     /// of its first estimate (ζ clamped to 0.01 … 0.3).
     fn distance(&self, f: &Estimate) -> f64 {
@@ -238,12 +249,7 @@ fn joint_fit(
                     && m.binned_db >= 3.0 =>
             {
                 past_fit = PastFit::Held;
-                slots.push(Slot {
-                    peak_hz: f,
-                    peak_psd: m.peak_psd,
-                    prominence_db: m.standing_db,
-                    estimates: vec![m.estimate],
-                })
+                slots.push(Slot::of_fit(&m))
             }
             Some(i) if i == past => {}
             Some(i) => seeded.push((i, m)),
@@ -276,8 +282,8 @@ fn joint_fit(
 /// Gives a mode seeded on a detected peak that the fit moved off every free peak a slot of its
 /// own, when another fitted mode took the peak it left (the slot holds a spectrum-fit
 /// estimate now: the model that was kept has both) and it stands as a mode found in the
-/// residuals must (`standing_db`, [`model::ROUGH_STANDING_DB`] below `rough_below_hz`;
-/// ζ < 0.3) on no other slot. The fit may trade a seed for a
+/// residuals must ([`model::stands_as_new`] with `standing_db` and `rough_below_hz`) on no
+/// other slot. The fit may trade a seed for a
 /// mode found later: a resonances file (`sweep_random.py` seed 58's f10: 83.8 / 0.147 and
 /// 114.5 / 0.048, only the 114.5 Hz peak detected) fitted the seed at 75.4 / 0.164 (the broad
 /// mode), then the residual mode seeded at 115.6 Hz converged to 115.06 / 0.040 and the seed
@@ -291,22 +297,14 @@ fn place_wandered(
     rough_below_hz: f64,
 ) {
     for (left_hz, m) in wandered {
-        let need_db = if m.estimate.frequency_hz < rough_below_hz {
-            model::ROUGH_STANDING_DB
-        } else {
-            standing_db
-        };
+        let (f, z) = (m.estimate.frequency_hz, m.estimate.damping);
+        let stands = model::stands_as_new(rough_below_hz, f, z, m.standing_db, standing_db);
         let taken = slots.iter().any(|s| {
             s.peak_hz == left_hz && s.estimates.iter().any(|e| e.method == Method::SpectrumFit)
         });
         let elsewhere = slots.iter().any(|s| s.fits(&m.estimate));
-        if taken && !elsewhere && m.standing_db >= need_db && m.estimate.damping < 0.3 {
-            slots.push(Slot {
-                peak_hz: m.estimate.frequency_hz,
-                peak_psd: m.peak_psd,
-                prominence_db: m.standing_db,
-                estimates: vec![m.estimate],
-            });
+        if taken && !elsewhere && stands {
+            slots.push(Slot::of_fit(&m));
         }
     }
 }
@@ -359,12 +357,7 @@ fn place_found(slots: &mut Vec<Slot>, found: Vec<FittedMode>) {
             !s.estimates.iter().any(|e| e.method == Method::SpectrumFit) && s.fits(&m.estimate)
         }) {
             Some(slot) => slot.push_fit(m.estimate),
-            None => slots.push(Slot {
-                peak_hz: m.estimate.frequency_hz,
-                peak_psd: m.peak_psd,
-                prominence_db: m.standing_db,
-                estimates: vec![m.estimate],
-            }),
+            None => slots.push(Slot::of_fit(&m)),
         }
     }
 }

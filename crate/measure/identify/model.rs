@@ -1199,14 +1199,9 @@ impl<'a> Setup<'a> {
         let candidate = self.best_fit(trial)?;
         let x = &candidate.0.x;
         let stands = new.iter().all(|&k| {
-            let need_db = if x[3 * k].exp() < input.rough_below_hz {
-                ROUGH_STANDING_DB
-            } else {
-                standing_db
-            };
             let (fk, zk) = (x[3 * k].exp(), x[3 * k + 1].exp());
-            problem.standing_db(x, trial.len(), k) >= need_db
-                && zk < 0.3
+            let standing = problem.standing_db(x, trial.len(), k);
+            stands_as_new(input.rough_below_hz, fk, zk, standing, standing_db)
                 && (!input.one_record() || problem.resolved(fk, zk))
         });
         let kept = problem.others_stand(x, trial.len(), new);
@@ -1324,7 +1319,26 @@ pub(crate) const SPECTRUM_STANDING_DB: f64 = 3.0;
 /// lumpy by ±3–7 dB over a few hertz, which the fit otherwise takes for modes (Klipper's
 /// pulse train swept 5–200 Hz in 2 s: 19.8 and 27.6 Hz, standing 3.9 and 6.3 dB, in a record
 /// with one 77.7 Hz mode).
-pub(crate) const ROUGH_STANDING_DB: f64 = 8.0;
+const ROUGH_STANDING_DB: f64 = 8.0;
+
+/// Whether a mode the model gained (found in the residuals, split off, or a seed's mode the
+/// fit traded for a later one) at `f` Hz with damping `z`, standing `standing` dB over the
+/// model without it, stands as it must: ≥ `standing_db` (≥ [`ROUGH_STANDING_DB`] below the
+/// input's `rough_below_hz`, where a fast sweep's drive is rough) with ζ < 0.3.
+pub(crate) fn stands_as_new(
+    rough_below_hz: f64,
+    f: f64,
+    z: f64,
+    standing: f64,
+    standing_db: f64,
+) -> bool {
+    let need_db = if f < rough_below_hz {
+        ROUGH_STANDING_DB
+    } else {
+        standing_db
+    };
+    standing >= need_db && z < 0.3
+}
 
 /// Fits the modes from `seeds` jointly, then adds modes while the information criterion says
 /// so (up to `max_modes`): one found in the residuals, a broad mode split in two where the
